@@ -1,0 +1,109 @@
+#include "apps/rtfact/common_options.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "core/render/packet_dispatch.h"
+#include "core/util/progress.h"
+
+namespace rtfact::app {
+
+Vec3f parseVec3(const std::string& text, const std::string& option) {
+    Vec3f v;
+    std::stringstream ss(text);
+    std::string part;
+    int i = 0;
+    while (std::getline(ss, part, ',')) {
+        if (i >= 3) break;
+        try {
+            size_t used = 0;
+            v[i] = std::stof(part, &used);
+            if (used != part.size() || !std::isfinite(v[i])) throw std::invalid_argument(part);
+        } catch (const std::exception&) {
+            throw CLI::ValidationError(option, "expected three numbers x,y,z, got '" + text + "'");
+        }
+        ++i;
+    }
+    if (i != 3 || std::count(text.begin(), text.end(), ',') != 2)
+        throw CLI::ValidationError(option, "expected three numbers x,y,z, got '" + text + "'");
+    return v;
+}
+
+std::pair<int, int> parseSize(const std::string& text) {
+    const auto x = text.find_first_of("xX");
+    auto bad = [&] { return CLI::ValidationError("--size", "expected WxH with 1..16384 pixels each, got '" + text + "'"); };
+    if (x == std::string::npos) throw bad();
+    int w = 0, h = 0;
+    try {
+        size_t uw = 0, uh = 0;
+        const std::string ws = text.substr(0, x), hs = text.substr(x + 1);
+        w = std::stoi(ws, &uw);
+        h = std::stoi(hs, &uh);
+        if (uw != ws.size() || uh != hs.size()) throw bad();
+    } catch (const CLI::ValidationError&) {
+        throw;
+    } catch (const std::exception&) {
+        throw bad();
+    }
+    if (w < 1 || h < 1 || w > 16384 || h > 16384) throw bad();
+    return {w, h};
+}
+
+void CommonOptions::addTo(CLI::App& cmd, const std::string& defaultOut) {
+    out = defaultOut;
+    cmd.add_option("-o,--out", out, "Output image (.png .exr .tif .jpg)")->capture_default_str();
+    cmd.add_option("--size", size, "Image size WxH")->capture_default_str();
+    cmd.add_option("--eye", eye, "Camera position x,y,z (default: fitted to the scene)");
+    cmd.add_option("--at", at, "Camera target x,y,z (default: scene centre)");
+    cmd.add_option("--up", up, "Camera up vector x,y,z");
+    cmd.add_option("--fov", fov, "Vertical field of view in degrees")->capture_default_str()->check(CLI::Range(1.0f, 170.0f));
+    cmd.add_option("--threads", threads, "Render threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+    cmd.add_option("--packet", packet, "Rays per packet (" + supportedPacketSizes() + ")")->capture_default_str();
+    cmd.add_option("--spp", spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 20));
+    cmd.add_flag("--quiet", quiet, "No progress bars");
+    cmd.add_flag("--stats", stats, "Print key=value statistics at the end");
+}
+
+void CommonOptions::finalize() {
+    std::tie(width, height) = parseSize(size);
+    if (!eye.empty()) eyeV = parseVec3(eye, "--eye");
+    if (!at.empty()) atV = parseVec3(at, "--at");
+    if (!up.empty()) upV = parseVec3(up, "--up");
+    bool ok = false;
+    dispatchPacketSize(packet, [&]<int N>() { ok = true; });
+    if (!ok) throw CLI::ValidationError("--packet", "must be one of " + supportedPacketSizes());
+    if (eyeV && atV && length(*eyeV - *atV) == 0.0f) throw CLI::ValidationError("--eye", "eye and --at coincide");
+    setProgressEnabled(!quiet);
+}
+
+CameraFrame CommonOptions::frame(const AABB& bounds, Vec3f viewDir, Vec3f upDefault) const {
+    const float aspect = float(width) / float(height);
+    CameraFrame f = fitCamera(bounds, fov, aspect, viewDir, upV.value_or(upDefault));
+    if (atV) f.at = *atV;
+    if (eyeV) {
+        f.eye = *eyeV;
+    } else if (atV) {
+        f.eye = *atV + (f.eye - bounds.center());
+    }
+    if (upV) f.up = *upV;
+    return f;
+}
+
+void Stats::add(const std::string& key, double value) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3f", value);
+    add(key, std::string(buf));
+}
+
+void Stats::print() const {
+    for (const auto& [k, v] : kv_) std::printf("%s=%s\n", k.c_str(), v.c_str());
+    std::fflush(stdout);
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace rtfact::app

@@ -1,0 +1,88 @@
+// Generic packet traversal of a KdTree<Elem>. Each stack entry carries its cell, so
+// every lane's interval is recomputed exactly with the shared slab test; lanes whose
+// hit lies before a cell drop out, and cells are visited near to far. An element
+// intersector may answer an inner node itself (level-of-detail cuts) by providing
+//   bool innerNode<D>(const KdTree<Elem>&, uint32_t node, const AABB& cell,
+//                     const RayPacket<N>&, Hit<N>&, int firstChunk) const
+// which returns true when the node's subtree need not be visited.
+#pragma once
+#include "core/accel/kdtree.h"
+#include "core/accel/ray_box.h"
+#include "core/concepts/intersector.h"
+
+namespace rtfact {
+
+template <class ElemIsect>
+struct KdTreeIntersector {
+    ElemIsect elem{};
+    template <int N>
+    using Hit = typename ElemIsect::template Hit<N>;
+
+    template <bool CommonOrigin, HitData D, class Elem, int N>
+    void intersect(const KdTree<Elem>& tree, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
+        hit.t = select(active, rays.tMax, Packet<N>(-kInfinity));
+        hit.id = Packet<N, int32_t>(-1);
+        traverse<CommonOrigin, D, false>(tree, rays, hit, active);
+        hit.t = select(active, hit.t, rays.tMax);
+    }
+
+    template <bool CommonOrigin, class Elem, int N>
+    Mask<N> occluded(const KdTree<Elem>& tree, const RayPacket<N>& rays, const Mask<N>& active) const {
+        Hit<N> hit;
+        hit.t = select(active, rays.tMax, Packet<N>(-kInfinity));
+        hit.id = Packet<N, int32_t>(-1);
+        traverse<CommonOrigin, HitData::Distance, true>(tree, rays, hit, active);
+        return active & (hit.id != Packet<N, int32_t>(-1));
+    }
+
+   private:
+    static constexpr int kStackSize = 256;
+
+    template <bool CommonOrigin, HitData D, bool AnyHit, class Elem, int N>
+    void traverse(const KdTree<Elem>& tree, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
+        if (tree.nodes.empty()) return;
+        constexpr int C = Packet<N>::C;
+        constexpr int W = Packet<N>::W;
+        struct Entry {
+            AABB cell;
+            uint32_t node, first;
+        };
+        Entry stack[kStackSize];
+        int sp = 0;
+        stack[sp++] = {tree.box, 0u, 0u};
+        while (sp > 0) {
+            const Entry e = stack[--sp];
+            int k = int(e.first);
+            while (k < C && none(chunkHitsBox<CommonOrigin>(e.cell.lo, e.cell.hi, rays, hit.t, k))) ++k;
+            if (k == C) continue;
+            const KdNode& node = tree.nodes[e.node];
+            if (node.isLeaf()) {
+                const uint32_t* ids = tree.indices.data() + node.first();
+                for (uint32_t i = 0; i < node.count; ++i) elem.template intersect<D>(tree.elems[ids[i]], ids[i], rays, hit, k);
+                if constexpr (AnyHit) {
+                    const Mask<N> found = hit.id != Packet<N, int32_t>(-1);
+                    hit.t = select(found, Packet<N>(-kInfinity), hit.t);
+                    if (all(found | ~active)) return;
+                }
+                continue;
+            }
+            if constexpr (requires { elem.template innerNode<D>(tree, e.node, e.cell, rays, hit, k); }) {
+                if (elem.template innerNode<D>(tree, e.node, e.cell, rays, hit, k)) continue;
+            }
+            const int axis = node.axis();
+            Entry lo{e.cell, node.left(), uint32_t(k)}, hi{e.cell, node.left() + 1, uint32_t(k)};
+            lo.cell.hi[axis] = node.split;
+            hi.cell.lo[axis] = node.split;
+            if (sp + 2 > kStackSize) continue;  // unreachable with the builder's depth limit
+            if (rays.dir[axis][k * W] < 0.0f) {
+                stack[sp++] = lo;
+                stack[sp++] = hi;
+            } else {
+                stack[sp++] = hi;
+                stack[sp++] = lo;
+            }
+        }
+    }
+};
+
+}  // namespace rtfact

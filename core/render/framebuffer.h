@@ -1,0 +1,54 @@
+// Float RGBA framebuffer with an optional depth channel; samples accumulate, so
+// progressive rendering is the sum divided by the sample count.
+#pragma once
+#include <vector>
+
+#include "core/concepts/framebuffer.h"
+
+namespace rtfact {
+
+class RGBAFramebuffer {
+   public:
+    RGBAFramebuffer(int w, int h, bool depth = false)
+        : w_(w), h_(h), rgba_(size_t(w) * size_t(h) * 4, 0.0f), depth_(depth ? size_t(w) * size_t(h) : 0, kInfinity) {}
+
+    int width() const { return w_; }
+    int height() const { return h_; }
+    bool hasDepth() const { return !depth_.empty(); }
+
+    template <int N>
+    void write(const PixelSample<N>& s, const Radiance<N>& r, const Mask<N>& valid) {
+        for (int i = 0; i < N; ++i) {
+            if (!valid[i]) continue;
+            const size_t p = size_t(s.py[i]) * size_t(w_) + size_t(s.px[i]);
+            float* d = &rgba_[p * 4];
+            d[0] += r.color.x[i];
+            d[1] += r.color.y[i];
+            d[2] += r.color.z[i];
+            d[3] += r.alpha[i];
+            if (!depth_.empty()) depth_[p] = std::min(depth_[p], float(r.depth[i]));
+        }
+    }
+
+    // Averaged pixel i (RGBA) after `samples` accumulated samples.
+    const float* rawRGBA() const { return rgba_.data(); }
+    std::vector<float> resolved(int samples) const {
+        std::vector<float> out(rgba_.size());
+        const float inv = 1.0f / float(samples > 0 ? samples : 1);
+        for (size_t i = 0; i < rgba_.size(); ++i) out[i] = rgba_[i] * inv;
+        return out;
+    }
+    const std::vector<float>& depth() const { return depth_; }
+    void clear() {
+        std::fill(rgba_.begin(), rgba_.end(), 0.0f);
+        std::fill(depth_.begin(), depth_.end(), kInfinity);
+    }
+
+   private:
+    int w_, h_;
+    std::vector<float> rgba_;
+    std::vector<float> depth_;
+};
+static_assert(Framebuffer<RGBAFramebuffer>);
+
+}  // namespace rtfact

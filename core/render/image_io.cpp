@@ -1,0 +1,117 @@
+#include "core/render/image_io.h"
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+#include "core/util/error.h"
+
+namespace rtfact {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lowerExt(const std::string& path) {
+    std::string e = fs::path(path).extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e;
+}
+
+bool isFloatFormat(const std::string& ext) { return ext == ".exr" || ext == ".hdr"; }
+
+float toSRGB(float v) {
+    v = std::clamp(v, 0.0f, 1.0f);
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+float fromSRGB(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+
+std::string tempPathFor(const std::string& path) {
+    const fs::path p(path);
+    std::random_device rd;
+    char tag[32];
+    std::snprintf(tag, sizeof tag, ".tmp%08x", rd());
+    return (p.parent_path() / ("." + p.stem().string() + tag + p.extension().string())).string();
+}
+
+}  // namespace
+
+void checkImageWritable(const std::string& path) {
+    const std::string ext = lowerExt(path);
+    if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff" && ext != ".jpg" && ext != ".jpeg" &&
+        ext != ".hdr")
+        throw Error(path, "unsupported image format '" + ext + "' (use .png, .exr, .tif, .jpg)");
+    fs::path dir = fs::path(path).parent_path();
+    if (dir.empty()) dir = ".";
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw Error(path, "output directory does not exist");
+    if (fs::is_directory(path, ec)) throw Error(path, "output path is a directory");
+    if (access(dir.c_str(), W_OK) != 0) throw Error(path, "output directory is not writable");
+}
+
+void writeImage(const std::string& path, int width, int height, const std::vector<float>& rgba) {
+    checkImageWritable(path);
+    const std::string ext = lowerExt(path);
+    const std::string tmp = tempPathFor(path);
+    const bool floats = isFloatFormat(ext);
+    const int channels = floats ? 4 : 3;  // 8-bit images carry the background-composited colour
+    auto out = OIIO::ImageOutput::create(tmp);
+    if (!out) throw Error(path, "cannot create image writer: " + OIIO::geterror());
+    OIIO::ImageSpec spec(width, height, channels, floats ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+    if (!floats) spec.attribute("oiio:ColorSpace", "sRGB");
+    bool ok = out->open(tmp, spec);
+    if (ok) {
+        if (floats) {
+            ok = out->write_image(OIIO::TypeDesc::FLOAT, rgba.data());
+        } else {
+            std::vector<unsigned char> px(size_t(width) * size_t(height) * size_t(channels));
+            for (size_t i = 0, n = size_t(width) * size_t(height); i < n; ++i) {
+                for (int c = 0; c < channels; ++c) {
+                    const float v = toSRGB(rgba[i * 4 + size_t(c)]);
+                    px[i * size_t(channels) + size_t(c)] = (unsigned char)std::lround(v * 255.0f);
+                }
+            }
+            ok = out->write_image(OIIO::TypeDesc::UINT8, px.data());
+        }
+        ok = out->close() && ok;
+    }
+    if (!ok) {
+        const std::string err = out->geterror();
+        out.reset();
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        throw Error(path, "cannot write image: " + err);
+    }
+    out.reset();
+    std::error_code ec;
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw Error(path, "cannot move the finished image into place");
+    }
+}
+
+Image readImage(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(path, "cannot read image: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    Image img;
+    img.width = spec.width;
+    img.height = spec.height;
+    img.channels = spec.nchannels;
+    img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
+    if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
+        throw Error(path, "cannot decode image: " + in->geterror());
+    if (spec.format == OIIO::TypeDesc::UINT8) {
+        for (size_t i = 0; i < img.pixels.size(); ++i)
+            if (img.channels < 4 || i % size_t(img.channels) != 3) img.pixels[i] = fromSRGB(img.pixels[i]);
+    }
+    return img;
+}
+
+}  // namespace rtfact

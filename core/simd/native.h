@@ -1,0 +1,212 @@
+// The one native-vector layer: GCC vector extensions give portable arithmetic,
+// comparisons and blends for every width; the few operations the compiler cannot
+// express generically (sqrt, rcp, floor, movemask, gather) use intrinsics per width.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <immintrin.h>
+
+#if defined(RTFACT_FORCE_SCALAR)
+#define RTFACT_NATIVE_WIDTH 1
+#elif defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__)
+#define RTFACT_NATIVE_WIDTH 16
+#elif defined(__AVX2__) && defined(__FMA__)
+#define RTFACT_NATIVE_WIDTH 8
+#elif defined(__SSE4_1__)
+#define RTFACT_NATIVE_WIDTH 4
+#else
+#define RTFACT_NATIVE_WIDTH 1
+#endif
+
+#define RTFACT_INLINE inline __attribute__((always_inline))
+
+namespace rtfact::simd {
+
+inline constexpr int kNativeWidth = RTFACT_NATIVE_WIDTH;
+
+constexpr const char* isaName() {
+    if constexpr (kNativeWidth == 16) return "avx512";
+    else if constexpr (kNativeWidth == 8) return "avx2";
+    else if constexpr (kNativeWidth == 4) return "sse4";
+    else return "scalar";
+}
+
+// A width W is usable when the build's ISA has registers of that many lanes.
+constexpr bool widthSupported(int w) {
+    return w == 1 || ((w == 4 || w == 8 || w == 16) && w <= kNativeWidth);
+}
+
+template <class T, int W>
+struct NativeType {
+    typedef T type __attribute__((vector_size(sizeof(T) * W)));
+};
+template <class T>
+struct NativeType<T, 1> {
+    using type = T;
+};
+// Raw native chunk of W lanes of T (a plain T when W == 1).
+template <class T, int W>
+using nvec = typename NativeType<T, W>::type;
+// Masks are 0 / -1 integers in every lane, also at width 1.
+template <int W>
+using nmask = nvec<int32_t, W>;
+
+template <class T, int W>
+RTFACT_INLINE nvec<T, W> splat(T s) {
+    if constexpr (W == 1) return s;
+    else return nvec<T, W>{} + s;
+}
+
+template <int W, class V>
+RTFACT_INLINE nmask<W> cmpLt(V a, V b) { if constexpr (W == 1) return -int32_t(a < b); else return a < b; }
+template <int W, class V>
+RTFACT_INLINE nmask<W> cmpLe(V a, V b) { if constexpr (W == 1) return -int32_t(a <= b); else return a <= b; }
+template <int W, class V>
+RTFACT_INLINE nmask<W> cmpEq(V a, V b) { if constexpr (W == 1) return -int32_t(a == b); else return a == b; }
+template <int W, class V>
+RTFACT_INLINE nmask<W> cmpNe(V a, V b) { if constexpr (W == 1) return -int32_t(a != b); else return a != b; }
+
+template <int W, class V>
+RTFACT_INLINE V select(nmask<W> m, V a, V b) {
+    if constexpr (W == 1) return m ? a : b;
+    else return m ? a : b;
+}
+
+template <int W, class V>
+RTFACT_INLINE V vmin(V a, V b) { if constexpr (W == 1) return a < b ? a : b; else return a < b ? a : b; }
+template <int W, class V>
+RTFACT_INLINE V vmax(V a, V b) { if constexpr (W == 1) return a > b ? a : b; else return a > b ? a : b; }
+
+template <int W>
+RTFACT_INLINE nvec<float, W> vsqrt(nvec<float, W> a) {
+    if constexpr (W == 1) return std::sqrt(a);
+#if RTFACT_NATIVE_WIDTH >= 16
+    else if constexpr (W == 16) return _mm512_sqrt_ps(a);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+    else if constexpr (W == 8) return _mm256_sqrt_ps(a);
+#endif
+    else return _mm_sqrt_ps(a);
+}
+
+template <int W>
+RTFACT_INLINE nvec<float, W> vfloor(nvec<float, W> a) {
+    if constexpr (W == 1) return std::floor(a);
+#if RTFACT_NATIVE_WIDTH >= 16
+    else if constexpr (W == 16) return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+    else if constexpr (W == 8) return _mm256_floor_ps(a);
+#endif
+    else return _mm_floor_ps(a);
+}
+
+// Full-precision reciprocal: hardware estimate refined by one Newton step.
+template <int W>
+RTFACT_INLINE nvec<float, W> vrcp(nvec<float, W> a) {
+    if constexpr (W == 1) return 1.0f / a;
+    else {
+        nvec<float, W> r;
+#if RTFACT_NATIVE_WIDTH >= 16
+        if constexpr (W == 16) r = _mm512_rcp14_ps(a);
+        else
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+        if constexpr (W == 8) r = _mm256_rcp_ps(a);
+        else
+#endif
+            r = _mm_rcp_ps(a);
+        return r * (2.0f - a * r);
+    }
+}
+
+template <int W>
+RTFACT_INLINE nvec<float, W> vabs(nvec<float, W> a) {
+    if constexpr (W == 1) return std::fabs(a);
+    else return (nvec<float, W>)((nvec<int32_t, W>)a & 0x7fffffff);
+}
+
+// Bit i set when lane i of the mask is set.
+template <int W>
+RTFACT_INLINE uint32_t movemask(nmask<W> m) {
+    if constexpr (W == 1) return m ? 1u : 0u;
+#if RTFACT_NATIVE_WIDTH >= 16
+    else if constexpr (W == 16) return _mm512_movepi32_mask((__m512i)m);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+    else if constexpr (W == 8) return uint32_t(_mm256_movemask_ps((__m256)m));
+#endif
+    else return uint32_t(_mm_movemask_ps((__m128)m));
+}
+
+template <int W>
+RTFACT_INLINE nvec<float, W> gather(const float* base, nvec<int32_t, W> idx) {
+    if constexpr (W == 1) return base[idx];
+#if RTFACT_NATIVE_WIDTH >= 16
+    else if constexpr (W == 16) return _mm512_i32gather_ps((__m512i)idx, base, 4);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+    else if constexpr (W == 8) return _mm256_i32gather_ps(base, (__m256i)idx, 4);
+#endif
+    else {
+        nvec<float, W> r;
+        for (int i = 0; i < W; ++i) r[i] = base[idx[i]];
+        return r;
+    }
+}
+
+template <int W>
+RTFACT_INLINE nvec<int32_t, W> gather(const int32_t* base, nvec<int32_t, W> idx) {
+    if constexpr (W == 1) return base[idx];
+#if RTFACT_NATIVE_WIDTH >= 16
+    else if constexpr (W == 16) return (nvec<int32_t, W>)_mm512_i32gather_epi32((__m512i)idx, base, 4);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+    else if constexpr (W == 8) return (nvec<int32_t, W>)_mm256_i32gather_epi32(base, (__m256i)idx, 4);
+#endif
+    else {
+        nvec<int32_t, W> r;
+        for (int i = 0; i < W; ++i) r[i] = base[idx[i]];
+        return r;
+    }
+}
+
+// Truncating float -> int and exact int -> float conversions.
+template <int W>
+RTFACT_INLINE nvec<int32_t, W> toInt(nvec<float, W> a) {
+    if constexpr (W == 1) return int32_t(a);
+    else return __builtin_convertvector(a, nvec<int32_t, W>);
+}
+template <int W>
+RTFACT_INLINE nvec<float, W> toFloat(nvec<int32_t, W> a) {
+    if constexpr (W == 1) return float(a);
+    else return __builtin_convertvector(a, nvec<float, W>);
+}
+
+template <int W, class V>
+RTFACT_INLINE auto hmin(V a) {
+    if constexpr (W == 1) return a;
+    else {
+        auto r = a[0];
+        for (int i = 1; i < W; ++i) r = a[i] < r ? a[i] : r;
+        return r;
+    }
+}
+template <int W, class V>
+RTFACT_INLINE auto hmax(V a) {
+    if constexpr (W == 1) return a;
+    else {
+        auto r = a[0];
+        for (int i = 1; i < W; ++i) r = a[i] > r ? a[i] : r;
+        return r;
+    }
+}
+
+template <int W, class V>
+RTFACT_INLINE auto& laneRef(V& v, int i) {
+    if constexpr (W == 1) { (void)i; return v; }
+    else return reinterpret_cast<std::remove_reference_t<decltype(v[0])>*>(&v)[i];
+}
+
+}  // namespace rtfact::simd
