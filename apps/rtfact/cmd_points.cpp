@@ -4,6 +4,7 @@
 namespace rtfact::app {
 
 void addPointsCommand(CLI::App&, CommandList&) {}
+void addGenPointsCommand(CLI::App&, CommandList&) {}
 std::optional<int> pointsInfo(const std::string&) { return std::nullopt; }
 
 }  // namespace rtfact::app

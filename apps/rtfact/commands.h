@@ -20,6 +20,9 @@ void addMeshCommand(CLI::App& app, CommandList& list);
 void addPointsCommand(CLI::App& app, CommandList& list);
 void addVolumeCommand(CLI::App& app, CommandList& list);
 void addGenCommand(CLI::App& app, CommandList& list);
+// Generators below `rtfact gen`: `gen points ...` (points/), `gen volume ...` (volume/).
+void addGenPointsCommand(CLI::App& gen, CommandList& list);
+void addGenVolumeCommand(CLI::App& gen, CommandList& list);
 void addInfoCommand(CLI::App& app, CommandList& list);
 
 // `rtfact info FILE` asks each domain in turn; a domain returns nullopt for files that

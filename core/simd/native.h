@@ -82,7 +82,7 @@ template <int W>
 RTFACT_INLINE nvec<float, W> vsqrt(nvec<float, W> a) {
     if constexpr (W == 1) return std::sqrt(a);
 #if RTFACT_NATIVE_WIDTH >= 16
-    else if constexpr (W == 16) return _mm512_sqrt_ps(a);
+    else if constexpr (W == 16) return _mm512_maskz_sqrt_ps(__mmask16(0xFFFF), a);
 #endif
 #if RTFACT_NATIVE_WIDTH >= 8
     else if constexpr (W == 8) return _mm256_sqrt_ps(a);
@@ -94,7 +94,7 @@ template <int W>
 RTFACT_INLINE nvec<float, W> vfloor(nvec<float, W> a) {
     if constexpr (W == 1) return std::floor(a);
 #if RTFACT_NATIVE_WIDTH >= 16
-    else if constexpr (W == 16) return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    else if constexpr (W == 16) return _mm512_maskz_roundscale_ps(__mmask16(0xFFFF), a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
 #endif
 #if RTFACT_NATIVE_WIDTH >= 8
     else if constexpr (W == 8) return _mm256_floor_ps(a);
@@ -109,7 +109,7 @@ RTFACT_INLINE nvec<float, W> vrcp(nvec<float, W> a) {
     else {
         nvec<float, W> r;
 #if RTFACT_NATIVE_WIDTH >= 16
-        if constexpr (W == 16) r = _mm512_rcp14_ps(a);
+        if constexpr (W == 16) r = _mm512_maskz_rcp14_ps(__mmask16(0xFFFF), a);
         else
 #endif
 #if RTFACT_NATIVE_WIDTH >= 8

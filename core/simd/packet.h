@@ -24,7 +24,7 @@ template <int N, class T = float>
 struct Packet;
 
 template <int N, class T>
-struct Packet {
+struct __attribute__((may_alias)) Packet {
     static_assert(ValidPacketSize<N>, "packet size must be 1 or a multiple of a supported SIMD width");
     static constexpr int size = N;
     static constexpr int W = chunkWidth(N);
@@ -112,7 +112,7 @@ struct Packet {
 
 // Lane mask (0 / all ones per lane) used for blends and as the active set of a packet.
 template <int N>
-struct Mask {
+struct __attribute__((may_alias)) Mask {
     static constexpr int W = chunkWidth(N);
     static constexpr int C = N / W;
     using Chunk = nmask<W>;

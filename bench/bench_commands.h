@@ -1,0 +1,10 @@
+// Subcommands of rtfact-bench; each receives the arguments after its name.
+#pragma once
+
+namespace rtfact::bench {
+
+int benchMesh(int argc, char** argv);
+int benchPoints(int argc, char** argv);
+int benchVolume(int argc, char** argv);
+
+}  // namespace rtfact::bench
