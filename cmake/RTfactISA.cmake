@@ -15,4 +15,4 @@ else()
 endif()
 # -ffp-contract=fast turns a*b+c into FMA; vector extensions warn on ABI changes we don't expose.
 set(RTFACT_CXX_FLAGS ${RTFACT_ISA_FLAGS} -ffp-contract=fast -fno-math-errno -Wall -Wextra -Wno-psabi
-    -Wno-missing-field-initializers -Wno-maybe-uninitialized)
+    -Wno-missing-field-initializers -Wno-maybe-uninitialized -Wno-restrict)

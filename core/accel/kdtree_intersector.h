@@ -4,7 +4,11 @@
 // intersector may answer an inner node itself (level-of-detail cuts) by providing
 //   bool innerNode<D>(const KdTree<Elem>&, uint32_t node, const AABB& cell,
 //                     const RayPacket<N>&, Hit<N>&, int firstChunk) const
-// which returns true when the node's subtree need not be visited.
+// which returns true when the node's subtree need not be visited. Structures whose
+// elements may reach beyond the split plane (discs stored once, by centre) can give
+// the children's cells themselves with
+//   void childCells(const KdTree<Elem>&, uint32_t node, const AABB& cell, AABB& lo, AABB& hi) const
+// An empty `indices` list means the elements are stored in leaf order (first..first+count).
 #pragma once
 #include "core/accel/kdtree.h"
 #include "core/accel/ray_box.h"
@@ -57,8 +61,14 @@ struct KdTreeIntersector {
             if (k == C) continue;
             const KdNode& node = tree.nodes[e.node];
             if (node.isLeaf()) {
-                const uint32_t* ids = tree.indices.data() + node.first();
-                for (uint32_t i = 0; i < node.count; ++i) elem.template intersect<D>(tree.elems[ids[i]], ids[i], rays, hit, k);
+                if (tree.indices.empty()) {
+                    for (uint32_t i = node.first(), end = node.first() + node.count; i < end; ++i)
+                        elem.template intersect<D>(tree.elems[i], i, rays, hit, k);
+                } else {
+                    const uint32_t* ids = tree.indices.data() + node.first();
+                    for (uint32_t i = 0; i < node.count; ++i)
+                        elem.template intersect<D>(tree.elems[ids[i]], ids[i], rays, hit, k);
+                }
                 if constexpr (AnyHit) {
                     const Mask<N> found = hit.id != Packet<N, int32_t>(-1);
                     hit.t = select(found, Packet<N>(-kInfinity), hit.t);
@@ -71,8 +81,12 @@ struct KdTreeIntersector {
             }
             const int axis = node.axis();
             Entry lo{e.cell, node.left(), uint32_t(k)}, hi{e.cell, node.left() + 1, uint32_t(k)};
-            lo.cell.hi[axis] = node.split;
-            hi.cell.lo[axis] = node.split;
+            if constexpr (requires { elem.childCells(tree, e.node, e.cell, lo.cell, hi.cell); }) {
+                elem.childCells(tree, e.node, e.cell, lo.cell, hi.cell);
+            } else {
+                lo.cell.hi[axis] = node.split;
+                hi.cell.lo[axis] = node.split;
+            }
             if (sp + 2 > kStackSize) continue;  // unreachable with the builder's depth limit
             if (rays.dir[axis][k * W] < 0.0f) {
                 stack[sp++] = lo;

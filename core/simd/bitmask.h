@@ -29,7 +29,7 @@ struct BitMask {
     bool all() const {
         for (int i = 0; i < kWords; ++i) {
             const int bits = (i == kWords - 1 && N % 64) ? N % 64 : 64;
-            const uint64_t full = bits == 64 ? ~uint64_t(0) : ((uint64_t(1) << bits) - 1);
+            const uint64_t full = bits >= 64 ? ~uint64_t(0) : ((uint64_t(1) << (bits & 63)) - 1);
             if (w[i] != full) return false;
         }
         return true;
