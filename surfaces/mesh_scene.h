@@ -1,0 +1,136 @@
+// MeshScene<Structure>: a triangle mesh as a GeometryScene, on the core's BVH or kd-tree
+// with the generic packet intersectors around TriangleIntersector. Every core integrator
+// (eyelight, direct light) and the surface integrators of this library render it.
+#pragma once
+#include <chrono>
+#include <memory>
+#include <type_traits>
+#include <vector>
+
+#include "core/accel/bvh_intersector.h"
+#include "core/accel/kdtree_intersector.h"
+#include "core/accel/sah_bvh_builder.h"
+#include "core/accel/sah_kdtree_builder.h"
+#include "core/concepts/scene.h"
+#include "core/render/tracer.h"
+#include "surfaces/mesh.h"
+#include "surfaces/triangle.h"
+
+namespace rtfact {
+
+// The triangles of a mesh in index order (triangle i = indices[3i..3i+2]).
+inline std::vector<Triangle> meshTriangles(const Mesh& m) {
+    std::vector<Triangle> t(m.triangles());
+    for (size_t i = 0; i < t.size(); ++i)
+        t[i] = {m.positions[m.indices[3 * i]], m.positions[m.indices[3 * i + 1]], m.positions[m.indices[3 * i + 2]]};
+    return t;
+}
+
+template <class Structure>
+struct MeshIntersectorFor;
+template <>
+struct MeshIntersectorFor<BVH<Triangle>> {
+    using type = BVHIntersector<TriangleIntersector>;
+};
+template <>
+struct MeshIntersectorFor<KdTree<Triangle>> {
+    using type = KdTreeIntersector<TriangleIntersector>;
+};
+
+// The BVH builder used for meshes: leaves of up to 4 triangles keep packets busy while
+// the tree stays shallow.
+inline SAHBVHBuilder meshBVHBuilder() {
+    SAHBVHBuilder b;
+    b.maxLeafSize = 8;
+    b.traversalCost = 1.0f;
+    b.intersectionCost = 1.0f;
+    return b;
+}
+
+template <class Structure = BVH<Triangle>>
+struct MeshScene {
+    std::shared_ptr<const Mesh> mesh;
+    Structure accel;
+    Tracer<typename MeshIntersectorFor<Structure>::type> tracer;
+    std::vector<Vec3f> materialColor;  // diffuse colour per material id
+    AABB box;
+    template <int N>
+    using Hit = TriangleIntersector::Hit<N>;
+
+    MeshScene() = default;
+    explicit MeshScene(std::shared_ptr<const Mesh> m) : mesh(std::move(m)) { build(); }
+
+    void build() {
+        const std::vector<Triangle> tris = meshTriangles(*mesh);
+        if constexpr (std::is_same_v<Structure, BVH<Triangle>>)
+            accel = buildBVH<Triangle>(meshBVHBuilder(), std::span<const Triangle>(tris));
+        else
+            accel = buildKdTree<Triangle>(SAHKdTreeBuilder{}, std::span<const Triangle>(tris));
+        box = mesh->bounds();
+        materialColor.clear();
+        for (const MeshMaterial& mm : mesh->materials) materialColor.push_back(mm.kd);
+    }
+    AABB bounds() const { return box; }
+    size_t memoryBytes() const { return accel.memoryBytes(); }
+
+    template <int N>
+    Hit<N> intersect(const RayPacket<N>& rays, const Mask<N>& active) const {
+        return tracer.intersect(accel, rays, active);
+    }
+    template <int N>
+    Hit<N> intersectDistance(const RayPacket<N>& rays, const Mask<N>& active) const {
+        return tracer.template intersect<HitData::Distance>(accel, rays, active);
+    }
+    template <int N>
+    Mask<N> occluded(const RayPacket<N>& rays, const Mask<N>& active) const {
+        return tracer.occluded(accel, rays, active);
+    }
+
+    // Position, interpolated shading normal, geometric normal (both facing the ray),
+    // uv, colour (vertex colour times material diffuse colour) and material id.
+    template <int N>
+    SurfacePoint<N> surface(const RayPacket<N>& rays, const Hit<N>& hit, const Mask<N>& valid) const {
+        SurfacePoint<N> sp;
+        sp.p = rays.org + rays.dir * hit.t;
+        sp.n = Vec3<N>(Vec3f(0, 0, 1));
+        sp.ng = sp.n;
+        sp.u = Packet<N>(0.0f);
+        sp.v = Packet<N>(0.0f);
+        sp.color = Vec3<N>(Vec3f(1.0f));
+        sp.material = Packet<N, int32_t>(0);
+        const Mesh& m = *mesh;
+        const bool hasUV = !m.uvs.empty(), hasColor = !m.colors.empty(), hasMat = !m.materialIds.empty();
+        BitMask<N>(valid).forEach([&](int i) {
+            const uint32_t t = uint32_t(hit.id[i]);
+            const uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
+            const float bu = hit.u[i], bv = hit.v[i], bw = 1.0f - bu - bv;
+            const Vec3f d = rays.dir.lane(i);
+            Vec3f ng = normalize(cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]));
+            if (dot(ng, d) > 0.0f) ng = -ng;
+            Vec3f n = normalize(m.normals[i0] * bw + m.normals[i1] * bu + m.normals[i2] * bv);
+            if (dot(n, ng) < 0.0f) n = -n;
+            sp.ng.setLane(i, ng);
+            sp.n.setLane(i, n);
+            if (hasUV) {
+                sp.u[i] = m.uvs[2 * i0] * bw + m.uvs[2 * i1] * bu + m.uvs[2 * i2] * bv;
+                sp.v[i] = m.uvs[2 * i0 + 1] * bw + m.uvs[2 * i1 + 1] * bu + m.uvs[2 * i2 + 1] * bv;
+            } else {
+                sp.u[i] = bu;
+                sp.v[i] = bv;
+            }
+            Vec3f col(1.0f);
+            if (hasColor) col = m.colors[i0] * bw + m.colors[i1] * bu + m.colors[i2] * bv;
+            if (hasMat) {
+                const int32_t mat = m.materialIds[t];
+                sp.material[i] = mat;
+                col = col * materialColor[size_t(mat)];
+            }
+            sp.color.setLane(i, col);
+        });
+        return sp;
+    }
+};
+static_assert(GeometryScene<MeshScene<BVH<Triangle>>>);
+static_assert(GeometryScene<MeshScene<KdTree<Triangle>>>);
+
+}  // namespace rtfact

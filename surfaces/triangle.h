@@ -1,0 +1,91 @@
+// Triangle and its intersector: one generic routine for single rays and packets.
+//
+// The test is Plücker-style on vertices relative to the ray origin: each edge (p -> q)
+// yields the edge function dot(cross(q - p, p + q), d). Computed from the difference
+// and the sum of its end points, the value of a shared edge is bit-exactly negated in
+// the neighbouring triangle (which walks the edge the other way), whatever FMA
+// contraction the compiler picks, so a ray on a shared edge hits at least one of the
+// two triangles: no cracks. With a common origin (primary rays, shadow rays cast from
+// a light) the edge vectors are scalar per triangle and each chunk only needs four dot
+// products.
+#pragma once
+#include "core/concepts/intersector.h"
+
+namespace rtfact {
+
+// Compact layout: the three vertices (36 bytes); the normal is recomputed per test
+// (a handful of scalar operations, cheaper than the extra memory traffic).
+struct Triangle {
+    Vec3f v0, v1, v2;
+    AABB bounds() const {
+        AABB b;
+        b.extend(v0).extend(v1).extend(v2);
+        return b;
+    }
+};
+static_assert(Primitive<Triangle>);
+static_assert(sizeof(Triangle) == 36);
+
+// Edge function vector of the edge p -> q (twice q x p), symmetric in the sense above.
+template <class V>
+RTFACT_INLINE V triangleEdge(const V& p, const V& q) {
+    return cross(q - p, p + q);
+}
+
+struct TriangleIntersector {
+    template <int N>
+    struct Hit {
+        Packet<N> t;
+        Packet<N, int32_t> id;
+        Packet<N> u, v;  // barycentric weights of v1 and v2
+    };
+
+    template <HitData D, int N>
+    RTFACT_INLINE void intersect(const Triangle& tri, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit,
+                                 int firstChunk) const {
+        constexpr int W = Packet<N>::W;
+        using P = Packet<W>;
+        using PI = Packet<W, int32_t>;
+        const Vec3f n = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+        const P zero(0.0f);
+        // Lanes hit when the three edge functions agree in sign and t is in range.
+        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const P& tnum) __attribute__((always_inline)) {
+            const P den = e0 + e1 + e2;
+            const auto inside = ((min(min(e0, e1), e2) >= zero) | (max(max(e0, e1), e2) <= zero)) & (den != zero);
+            if (none(inside)) return;
+            const P inv = P(1.0f) / den;
+            const P t = tnum * inv;
+            P& th = hit.t.chunk(k);
+            const auto m = inside & (t > rays.tMin.chunk(k)) & (t < th);
+            if (none(m)) return;
+            th = select(m, t, th);
+            hit.id.chunk(k) = select(m, PI(int32_t(id)), hit.id.chunk(k));
+            if constexpr (D == HitData::Shading) {
+                hit.u.chunk(k) = select(m, e1 * inv, hit.u.chunk(k));
+                hit.v.chunk(k) = select(m, e2 * inv, hit.v.chunk(k));
+            }
+        };
+        if (rays.commonOrigin) {
+            const Vec3f o(rays.org.x[0], rays.org.y[0], rays.org.z[0]);
+            const Vec3f a = tri.v0 - o, b = tri.v1 - o, c = tri.v2 - o;
+            const Vec3<W> e0(triangleEdge(b, c)), e1(triangleEdge(c, a)), e2(triangleEdge(a, b));
+            // den = e0 + e1 + e2 = -2 dot(n, d), so t = dot(n, a) / dot(n, d) = -2 dot(n, a) / den.
+            const P tnum(-2.0f * dot(n, a));
+            for (int k = firstChunk; k < Packet<N>::C; ++k) {
+                const Vec3<W> d = rays.dir.chunk(k);
+                finish(k, dot(e0, d), dot(e1, d), dot(e2, d), tnum);
+            }
+        } else {
+            const Vec3<W> v0(tri.v0), v1(tri.v1), v2(tri.v2), nn(n);
+            for (int k = firstChunk; k < Packet<N>::C; ++k) {
+                const Vec3<W> o = rays.org.chunk(k), d = rays.dir.chunk(k);
+                const Vec3<W> a = v0 - o, b = v1 - o, c = v2 - o;
+                finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d),
+                       P(-2.0f) * dot(nn, a));
+            }
+        }
+    }
+};
+static_assert(ElementIntersector<TriangleIntersector, Triangle>);
+
+}  // namespace rtfact
