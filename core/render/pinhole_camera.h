@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/concepts/camera.h"
+#include "core/math/aabb.h"
 
 namespace rtfact {
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <immintrin.h>
+#include <type_traits>
 
 #if defined(RTFACT_FORCE_SCALAR)
 #define RTFACT_NATIVE_WIDTH 1
@@ -48,35 +49,168 @@ struct NativeType<T, 1> {
 // Raw native chunk of W lanes of T (a plain T when W == 1).
 template <class T, int W>
 using nvec = typename NativeType<T, W>::type;
-// Masks are 0 / -1 integers in every lane, also at width 1.
+// Masks: AVX-512 keeps 16-lane masks in k registers (one bit per lane); other widths
+// use 0 / -1 integers per lane, also at width 1.
+#if RTFACT_NATIVE_WIDTH >= 16
 template <int W>
-using nmask = nvec<int32_t, W>;
+inline constexpr bool kBitMask = (W == 16);
+#else
+template <int W>
+inline constexpr bool kBitMask = false;
+#endif
+template <int W, bool Bits = kBitMask<W>>
+struct MaskType {
+    using type = nvec<int32_t, W>;
+};
+#if RTFACT_NATIVE_WIDTH >= 16
+template <>
+struct MaskType<16, true> {
+    using type = __mmask16;
+};
+#endif
+template <int W>
+using nmask = typename MaskType<W>::type;
+
+template <int W>
+RTFACT_INLINE nmask<W> maskSplat(bool b) {
+    if constexpr (kBitMask<W>) return nmask<W>(b ? 0xFFFF : 0);
+    else if constexpr (W == 1) return b ? -1 : 0;
+    else return nvec<int32_t, W>{} - int32_t(b ? 1 : 0);
+}
+template <int W>
+RTFACT_INLINE bool maskLane(nmask<W> m, int j) {
+    if constexpr (kBitMask<W>) return (m >> j) & 1;
+    else if constexpr (W == 1) return m != 0;
+    else return m[j] != 0;
+}
+template <int W>
+RTFACT_INLINE void maskSetLane(nmask<W>& m, int j, bool b) {
+    if constexpr (kBitMask<W>) m = nmask<W>(b ? (m | (1u << j)) : (m & ~(1u << j)));
+    else if constexpr (W == 1) m = b ? -1 : 0;
+    else m[j] = b ? -1 : 0;
+}
 
 template <class T, int W>
 RTFACT_INLINE nvec<T, W> splat(T s) {
-    if constexpr (W == 1) return s;
-    else return nvec<T, W>{} + s;
+    if constexpr (W == 1) {
+        return s;
+    } else {
+    if constexpr (std::is_same_v<T, float>) {
+        // Broadcast intrinsics: GCC builds generic vector fills through the stack.
+#if RTFACT_NATIVE_WIDTH >= 16
+        if constexpr (W == 16) return _mm512_set1_ps(s);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+        if constexpr (W == 8) return _mm256_set1_ps(s);
+#endif
+        if constexpr (W == 4) return _mm_set1_ps(s);
+    } else if constexpr (sizeof(T) == 4) {
+        using I = nvec<int32_t, W>;
+#if RTFACT_NATIVE_WIDTH >= 16
+        if constexpr (W == 16) return (nvec<T, W>)(I)_mm512_set1_epi32(int32_t(s));
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+        if constexpr (W == 8) return (nvec<T, W>)(I)_mm256_set1_epi32(int32_t(s));
+#endif
+        if constexpr (W == 4) return (nvec<T, W>)(I)_mm_set1_epi32(int32_t(s));
+    }
+    nvec<T, W> r;
+    for (int i = 0; i < W; ++i) r[i] = s;
+    return r;
+    }
 }
 
+#if RTFACT_NATIVE_WIDTH >= 16
+// k-mask comparisons for 16 lanes of float, int32 or uint32.
+template <int Pred, class V>
+RTFACT_INLINE __mmask16 cmp16(V a, V b) {
+    using E = std::remove_cvref_t<decltype(a[0])>;
+    if constexpr (std::is_same_v<E, float>) {
+        constexpr int fp = Pred == 0 ? _CMP_LT_OQ : Pred == 1 ? _CMP_LE_OQ : Pred == 2 ? _CMP_EQ_OQ : _CMP_NEQ_UQ;
+        return _mm512_cmp_ps_mask(a, b, fp);
+    } else if constexpr (std::is_signed_v<E>) {
+        constexpr int ip = Pred == 0 ? _MM_CMPINT_LT : Pred == 1 ? _MM_CMPINT_LE : Pred == 2 ? _MM_CMPINT_EQ : _MM_CMPINT_NE;
+        return _mm512_cmp_epi32_mask((__m512i)a, (__m512i)b, ip);
+    } else {
+        constexpr int ip = Pred == 0 ? _MM_CMPINT_LT : Pred == 1 ? _MM_CMPINT_LE : Pred == 2 ? _MM_CMPINT_EQ : _MM_CMPINT_NE;
+        return _mm512_cmp_epu32_mask((__m512i)a, (__m512i)b, ip);
+    }
+}
+#define RTFACT_CMP16(pred, a, b) if constexpr (kBitMask<W>) return cmp16<pred>(a, b); else
+#else
+#define RTFACT_CMP16(pred, a, b)
+#endif
+
 template <int W, class V>
-RTFACT_INLINE nmask<W> cmpLt(V a, V b) { if constexpr (W == 1) return -int32_t(a < b); else return a < b; }
+RTFACT_INLINE nmask<W> cmpLt(V a, V b) {
+    RTFACT_CMP16(0, a, b)
+    if constexpr (W == 1) return -int32_t(a < b); else return a < b;
+}
 template <int W, class V>
-RTFACT_INLINE nmask<W> cmpLe(V a, V b) { if constexpr (W == 1) return -int32_t(a <= b); else return a <= b; }
+RTFACT_INLINE nmask<W> cmpLe(V a, V b) {
+    RTFACT_CMP16(1, a, b)
+    if constexpr (W == 1) return -int32_t(a <= b); else return a <= b;
+}
 template <int W, class V>
-RTFACT_INLINE nmask<W> cmpEq(V a, V b) { if constexpr (W == 1) return -int32_t(a == b); else return a == b; }
+RTFACT_INLINE nmask<W> cmpEq(V a, V b) {
+    RTFACT_CMP16(2, a, b)
+    if constexpr (W == 1) return -int32_t(a == b); else return a == b;
+}
 template <int W, class V>
-RTFACT_INLINE nmask<W> cmpNe(V a, V b) { if constexpr (W == 1) return -int32_t(a != b); else return a != b; }
+RTFACT_INLINE nmask<W> cmpNe(V a, V b) {
+    RTFACT_CMP16(3, a, b)
+    if constexpr (W == 1) return -int32_t(a != b); else return a != b;
+}
+#undef RTFACT_CMP16
 
 template <int W, class V>
 RTFACT_INLINE V select(nmask<W> m, V a, V b) {
+#if RTFACT_NATIVE_WIDTH >= 16
+    if constexpr (kBitMask<W>) {
+        using E = std::remove_cvref_t<decltype(a[0])>;
+        if constexpr (std::is_same_v<E, float>) return _mm512_mask_blend_ps(m, b, a);
+        else return (V)_mm512_mask_blend_epi32(m, (__m512i)b, (__m512i)a);
+    } else
+#endif
     if constexpr (W == 1) return m ? a : b;
     else return m ? a : b;
 }
 
+// min/max through intrinsics: the ternary form becomes compare+blend against constants.
 template <int W, class V>
-RTFACT_INLINE V vmin(V a, V b) { if constexpr (W == 1) return a < b ? a : b; else return a < b ? a : b; }
+RTFACT_INLINE V vmin(V a, V b) {
+    if constexpr (W == 1) return a < b ? a : b;
+    else {
+        using E = std::remove_cvref_t<decltype(a[0])>;
+        if constexpr (std::is_same_v<E, float>) {
+#if RTFACT_NATIVE_WIDTH >= 16
+            if constexpr (W == 16) return _mm512_min_ps(a, b);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+            if constexpr (W == 8) return _mm256_min_ps(a, b);
+#endif
+            if constexpr (W == 4) return _mm_min_ps(a, b);
+        }
+        return a < b ? a : b;
+    }
+}
 template <int W, class V>
-RTFACT_INLINE V vmax(V a, V b) { if constexpr (W == 1) return a > b ? a : b; else return a > b ? a : b; }
+RTFACT_INLINE V vmax(V a, V b) {
+    if constexpr (W == 1) return a > b ? a : b;
+    else {
+        using E = std::remove_cvref_t<decltype(a[0])>;
+        if constexpr (std::is_same_v<E, float>) {
+#if RTFACT_NATIVE_WIDTH >= 16
+            if constexpr (W == 16) return _mm512_max_ps(a, b);
+#endif
+#if RTFACT_NATIVE_WIDTH >= 8
+            if constexpr (W == 8) return _mm256_max_ps(a, b);
+#endif
+            if constexpr (W == 4) return _mm_max_ps(a, b);
+        }
+        return a > b ? a : b;
+    }
+}
 
 template <int W>
 RTFACT_INLINE nvec<float, W> vsqrt(nvec<float, W> a) {
@@ -131,6 +265,7 @@ RTFACT_INLINE nvec<float, W> vabs(nvec<float, W> a) {
 template <int W>
 RTFACT_INLINE uint32_t movemask(nmask<W> m) {
     if constexpr (W == 1) return m ? 1u : 0u;
+    else if constexpr (kBitMask<W>) return uint32_t(m);
 #if RTFACT_NATIVE_WIDTH >= 16
     else if constexpr (W == 16) return _mm512_movepi32_mask((__m512i)m);
 #endif

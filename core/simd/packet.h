@@ -121,37 +121,37 @@ struct __attribute__((may_alias)) Mask {
 
     Mask() = default;
     RTFACT_INLINE Mask(bool b) {  // NOLINT
-        for (int i = 0; i < C; ++i) c[i] = splat<int32_t, W>(b ? -1 : 0);
+        for (int i = 0; i < C; ++i) c[i] = maskSplat<W>(b);
     }
-    RTFACT_INLINE bool operator[](int i) const { return reinterpret_cast<const int32_t*>(c)[i] != 0; }
-    RTFACT_INLINE void set(int i, bool b) { reinterpret_cast<int32_t*>(c)[i] = b ? -1 : 0; }
+    RTFACT_INLINE bool operator[](int i) const { return maskLane<W>(c[i / W], i % W); }
+    RTFACT_INLINE void set(int i, bool b) { maskSetLane<W>(c[i / W], i % W, b); }
     RTFACT_INLINE ChunkMask& chunk(int k) { return reinterpret_cast<ChunkMask&>(c[k]); }
     RTFACT_INLINE const ChunkMask& chunk(int k) const { return reinterpret_cast<const ChunkMask&>(c[k]); }
 
     friend RTFACT_INLINE Mask operator&(const Mask& a, const Mask& b) {
         Mask r;
-        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] & b.c[i];
+        for (int i = 0; i < C; ++i) r.c[i] = Chunk(a.c[i] & b.c[i]);
         return r;
     }
     friend RTFACT_INLINE Mask operator|(const Mask& a, const Mask& b) {
         Mask r;
-        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] | b.c[i];
+        for (int i = 0; i < C; ++i) r.c[i] = Chunk(a.c[i] | b.c[i]);
         return r;
     }
     friend RTFACT_INLINE Mask operator^(const Mask& a, const Mask& b) {
         Mask r;
-        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] ^ b.c[i];
+        for (int i = 0; i < C; ++i) r.c[i] = Chunk(a.c[i] ^ b.c[i]);
         return r;
     }
     friend RTFACT_INLINE Mask operator~(const Mask& a) {
         Mask r;
-        for (int i = 0; i < C; ++i) r.c[i] = ~a.c[i];
+        for (int i = 0; i < C; ++i) r.c[i] = Chunk(~a.c[i]);
         return r;
     }
     // a & ~b
     friend RTFACT_INLINE Mask andNot(const Mask& a, const Mask& b) {
         Mask r;
-        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] & ~b.c[i];
+        for (int i = 0; i < C; ++i) r.c[i] = Chunk(a.c[i] & ~b.c[i]);
         return r;
     }
     Mask& operator&=(const Mask& b) { return *this = *this & b; }
@@ -242,13 +242,13 @@ RTFACT_INLINE Packet<N, T> gather(const T* base, const Packet<N, int32_t>& idx) 
 template <int N>
 RTFACT_INLINE bool any(const Mask<N>& m) {
     auto a = m.c[0];
-    for (int i = 1; i < Mask<N>::C; ++i) a |= m.c[i];
+    for (int i = 1; i < Mask<N>::C; ++i) a = typename Mask<N>::Chunk(a | m.c[i]);
     return movemask<Mask<N>::W>(a) != 0;
 }
 template <int N>
 RTFACT_INLINE bool all(const Mask<N>& m) {
     auto a = m.c[0];
-    for (int i = 1; i < Mask<N>::C; ++i) a &= m.c[i];
+    for (int i = 1; i < Mask<N>::C; ++i) a = typename Mask<N>::Chunk(a & m.c[i]);
     constexpr uint32_t full = Mask<N>::W == 32 ? ~0u : ((1u << Mask<N>::W) - 1u);
     return movemask<Mask<N>::W>(a) == full;
 }
