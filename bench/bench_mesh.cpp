@@ -1,13 +1,392 @@
-// rtfact-bench mesh: placeholder until its issue lands.
+// rtfact-bench mesh FILE: RTfact's BVH packet tracer against Embree 3 on the same
+// triangles, camera and thread count, in one process. Primary rays (eyelight: nearest
+// hit plus a normal lookup) and one shadow ray per hit towards a point light. Embree
+// runs in its best packet mode for coherent rays: rtcIntersect16/rtcOccluded16 on 4x4
+// pixel blocks with the coherent context flag and a medium-quality build.
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <memory>
+#include <sstream>
+#include <thread>
 
 #include "bench/bench_commands.h"
+#include "core/render/pinhole_camera.h"
+#include "core/render/ray_tracing_renderer.h"
+#include "core/util/error.h"
+#include "surfaces/mesh_loader.h"
+#include "surfaces/mesh_scene.h"
 
 namespace rtfact::bench {
+namespace {
 
-int benchMesh(int, char**) {
-    std::fprintf(stderr, "rtfact-bench: mesh benchmark not built yet\n");
-    return 2;
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+Vec3f parseV(const std::string& s, const char* opt) {
+    Vec3f v;
+    char c1 = 0, c2 = 0;
+    std::istringstream in(s);
+    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',')
+        throw Error("", std::string(opt) + ": expected x,y,z, got '" + s + "'");
+    return v;
+}
+
+constexpr int kTile = 32;
+
+// What both tracers produce per pixel, so their results can be compared.
+struct Frame {
+    int w, h;
+    std::vector<float> t;       // nearest hit distance (inf: miss)
+    std::vector<float> shade;   // eyelight value
+    std::vector<uint8_t> lit;   // shadow result: 1 = light visible
+    Frame(int w_, int h_) : w(w_), h(h_), t(size_t(w_) * h_), shade(size_t(w_) * h_), lit(size_t(w_) * h_) {}
+};
+
+struct Setup {
+    PinholeCamera cam;
+    Vec3f light;
+    std::vector<Vec3f> triNormal;  // unit geometric normal per input triangle
+};
+
+template <class F>
+double timeTiles(int threads, int w, int h, F&& tile) {
+    const int tx = (w + kTile - 1) / kTile, ty = (h + kTile - 1) / kTile;
+    tbb::task_arena arena(threads);
+    const auto t0 = Clock::now();
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<int>(0, tx * ty, 1), [&](const tbb::blocked_range<int>& r) {
+            for (int i = r.begin(); i != r.end(); ++i) tile((i % tx) * kTile, (i / tx) * kTile);
+        });
+    });
+    return msSince(t0);
+}
+
+// ---- RTfact ---------------------------------------------------------------------------
+
+template <int N>
+struct RTfactSide {
+    static constexpr int bw = packetBlockWidth(N), bh = N / bw;
+    const MeshScene<BVH<Triangle>>& scene;
+    const Setup& s;
+
+    void pixels(int x0, int y0, Packet<N>& px, Packet<N>& py) const {
+        for (int i = 0; i < N; ++i) {
+            px[i] = float(x0 + i % bw) + 0.5f;
+            py[i] = float(y0 + i / bw) + 0.5f;
+        }
+    }
+    void primaryTile(Frame& f, int tx, int ty) const {
+        for (int y = ty; y < std::min(ty + kTile, f.h); y += bh)
+            for (int x = tx; x < std::min(tx + kTile, f.w); x += bw) {
+                Packet<N> px, py;
+                pixels(x, y, px, py);
+                RayPacket<N> rays;
+                s.cam.template generate<N>(px, py, rays);
+                const auto hit = scene.template intersect<N>(rays, Mask<N>(true));
+                for (int i = 0; i < N; ++i) {
+                    const size_t pix = size_t(y + i / bw) * f.w + size_t(x + i % bw);
+                    const int id = hit.id[i];
+                    f.t[pix] = id >= 0 ? hit.t[i] : kInfinity;
+                    f.shade[pix] = id >= 0 ? std::fabs(dot(s.triNormal[size_t(id)], rays.dir.lane(i))) : 0.0f;
+                }
+            }
+    }
+    // Shadow rays start at the light and end just before the hit point, so a packet
+    // shares its origin (the same segments as surface-to-light rays).
+    void shadowTile(Frame& f, const Frame& primary, int tx, int ty) const {
+        for (int y = ty; y < std::min(ty + kTile, f.h); y += bh)
+            for (int x = tx; x < std::min(tx + kTile, f.w); x += bw) {
+                Packet<N> px, py;
+                pixels(x, y, px, py);
+                RayPacket<N> cam;
+                s.cam.template generate<N>(px, py, cam);
+                Packet<N> t;
+                for (int i = 0; i < N; ++i) t[i] = primary.t[size_t(y + i / bw) * f.w + size_t(x + i % bw)];
+                const Mask<N> active = t < Packet<N>(kInfinity);
+                if (none(active)) continue;
+                const Vec3<N> p = cam.org + cam.dir * select(active, t, Packet<N>(0.0f));
+                RayPacket<N> sh;
+                sh.org = Vec3<N>(s.light);
+                const Vec3<N> d = p - sh.org;
+                const Packet<N> dist = length(d);
+                sh.dir = d * rcp(max(dist, Packet<N>(1e-30f)));
+                sh.tMin = Packet<N>(0.0f);
+                sh.tMax = dist * Packet<N>(1.0f - 1e-4f);
+                sh.commonOrigin = true;
+                sh.finalize();
+                const Mask<N> occ = scene.template occluded<N>(sh, active);
+                for (int i = 0; i < N; ++i)
+                    if (active[i]) f.lit[size_t(y + i / bw) * f.w + size_t(x + i % bw)] = occ[i] ? 0 : 1;
+            }
+    }
+};
+
+// ---- Embree -----------------------------------------------------------------------------
+
+std::atomic<int64_t> gEmbreeBytes{0};
+bool embreeMemory(void*, ssize_t bytes, bool) {
+    gEmbreeBytes += bytes;
+    return true;
+}
+
+struct EmbreeSide {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    const Setup& s;
+
+    EmbreeSide(const Setup& setup, int threads) : s(setup) {
+        const std::string cfg = "threads=" + std::to_string(threads);
+        device = rtcNewDevice(cfg.c_str());
+        if (!device) throw Error("", "cannot create an Embree device");
+        rtcSetDeviceMemoryMonitorFunction(device, embreeMemory, nullptr);
+    }
+    ~EmbreeSide() {
+        if (scene) rtcReleaseScene(scene);
+        rtcReleaseDevice(device);
+    }
+    // Returns build ms (buffer copy excluded: both sides start from the loaded mesh).
+    double build(const Mesh& m) {
+        if (scene) rtcReleaseScene(scene);
+        gEmbreeBytes = 0;  // counts what this scene allocates
+        scene = rtcNewScene(device);
+        rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
+        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_MEDIUM);
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                              3 * sizeof(float), m.positions.size()));
+        for (size_t i = 0; i < m.positions.size(); ++i) {
+            v[3 * i] = m.positions[i].x;
+            v[3 * i + 1] = m.positions[i].y;
+            v[3 * i + 2] = m.positions[i].z;
+        }
+        auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(uint32_t), m.triangles()));
+        std::copy(m.indices.begin(), m.indices.end(), idx);
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(scene, g);
+        rtcReleaseGeometry(g);
+        const auto t0 = Clock::now();
+        rtcCommitScene(scene);
+        return msSince(t0);
+    }
+
+    static void pixels(int x0, int y0, Packet<16>& px, Packet<16>& py) {
+        for (int i = 0; i < 16; ++i) {
+            px[i] = float(x0 + i % 4) + 0.5f;
+            py[i] = float(y0 + i / 4) + 0.5f;
+        }
+    }
+    void primaryTile(Frame& f, int tx, int ty) const {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        alignas(64) int valid[16];
+        std::fill(valid, valid + 16, -1);
+        for (int y = ty; y < std::min(ty + kTile, f.h); y += 4)
+            for (int x = tx; x < std::min(tx + kTile, f.w); x += 4) {
+                Packet<16> px, py;
+                pixels(x, y, px, py);
+                RayPacket<16> rays;
+                s.cam.generate<16>(px, py, rays);
+                RTCRayHit16 rh;
+                for (int i = 0; i < 16; ++i) {
+                    rh.ray.org_x[i] = rays.org.x[i];
+                    rh.ray.org_y[i] = rays.org.y[i];
+                    rh.ray.org_z[i] = rays.org.z[i];
+                    rh.ray.dir_x[i] = rays.dir.x[i];
+                    rh.ray.dir_y[i] = rays.dir.y[i];
+                    rh.ray.dir_z[i] = rays.dir.z[i];
+                    rh.ray.tnear[i] = 0.0f;
+                    rh.ray.tfar[i] = kInfinity;
+                    rh.ray.time[i] = 0.0f;
+                    rh.ray.mask[i] = ~0u;
+                    rh.ray.flags[i] = 0;
+                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                }
+                rtcIntersect16(valid, scene, &ctx, &rh);
+                for (int i = 0; i < 16; ++i) {
+                    const size_t pix = size_t(y + i / 4) * f.w + size_t(x + i % 4);
+                    const bool h = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+                    f.t[pix] = h ? rh.ray.tfar[i] : kInfinity;
+                    f.shade[pix] = h ? std::fabs(dot(s.triNormal[rh.hit.primID[i]], rays.dir.lane(i))) : 0.0f;
+                }
+            }
+    }
+    // fromLight: the same light-to-point segments as RTfact; else point-to-light rays.
+    void shadowTile(Frame& f, const Frame& primary, int tx, int ty, bool fromLight) const {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        alignas(64) int valid[16];
+        for (int y = ty; y < std::min(ty + kTile, f.h); y += 4)
+            for (int x = tx; x < std::min(tx + kTile, f.w); x += 4) {
+                Packet<16> px, py;
+                pixels(x, y, px, py);
+                RayPacket<16> cam;
+                s.cam.generate<16>(px, py, cam);
+                RTCRay16 r;
+                bool any = false;
+                for (int i = 0; i < 16; ++i) {
+                    const float t = primary.t[size_t(y + i / 4) * f.w + size_t(x + i % 4)];
+                    valid[i] = t < kInfinity ? -1 : 0;
+                    any |= valid[i] != 0;
+                    const Vec3f p = cam.org.lane(i) + cam.dir.lane(i) * (valid[i] ? t : 0.0f);
+                    const Vec3f d = fromLight ? p - s.light : s.light - p;
+                    const float dist = std::max(length(d), 1e-30f);
+                    const Vec3f o = fromLight ? s.light : p;
+                    r.org_x[i] = o.x;
+                    r.org_y[i] = o.y;
+                    r.org_z[i] = o.z;
+                    r.dir_x[i] = d.x / dist;
+                    r.dir_y[i] = d.y / dist;
+                    r.dir_z[i] = d.z / dist;
+                    // Surface-to-light rays skip their own surface with a relative offset.
+                    r.tnear[i] = fromLight ? 0.0f : 1e-4f * dist;
+                    r.tfar[i] = fromLight ? dist * (1.0f - 1e-4f) : dist;
+                    r.time[i] = 0.0f;
+                    r.mask[i] = ~0u;
+                    r.flags[i] = 0;
+                }
+                if (!any) continue;
+                rtcOccluded16(valid, scene, &ctx, &r);
+                for (int i = 0; i < 16; ++i)
+                    if (valid[i]) f.lit[size_t(y + i / 4) * f.w + size_t(x + i % 4)] = r.tfar[i] < 0.0f ? 0 : 1;
+            }
+    }
+};
+
+struct Result {
+    double ms = 1e30;
+    uint64_t rays = 0;
+    double mrays() const { return double(rays) / (ms * 1000.0); }
+};
+
+uint64_t countHits(const Frame& f) {
+    return uint64_t(std::count_if(f.t.begin(), f.t.end(), [](float t) { return t < kInfinity; }));
+}
+
+template <int N>
+int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat) {
+    std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w, h,
+                N, allThreads);
+    auto meshPtr = std::make_shared<const Mesh>(mesh);
+    const std::vector<int> threadCounts = allThreads > 1 ? std::vector<int>{1, allThreads} : std::vector<int>{1};
+    MeshScene<BVH<Triangle>> scene;
+    scene.mesh = meshPtr;
+    double rtBuild[2] = {1e30, 1e30}, emBuild[2] = {1e30, 1e30};
+    std::unique_ptr<EmbreeSide> em;
+    for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
+        const int T = threadCounts[ti];
+        em = std::make_unique<EmbreeSide>(setup, T);
+        for (int r = 0; r < repeat; ++r) {
+            tbb::task_arena arena(T);
+            const auto t0 = Clock::now();
+            arena.execute([&] { scene.build(); });
+            rtBuild[ti] = std::min(rtBuild[ti], msSince(t0));
+            arena.execute([&] { emBuild[ti] = std::min(emBuild[ti], em->build(mesh)); });
+        }
+        std::printf("build_ms_threads%d: rtfact=%.2f embree=%.2f\n", T, rtBuild[ti], emBuild[ti]);
+    }
+    const double rtBytes = double(scene.memoryBytes()), emBytes = double(gEmbreeBytes.load());
+    std::printf("memory_bytes: rtfact=%.0f embree=%.0f ratio_memory=%.3f\n", rtBytes, emBytes, rtBytes / std::max(emBytes, 1.0));
+
+    RTfactSide<N> rt{scene, setup};
+    Frame fr(w, h), fe(w, h), base(w, h);
+    // Reference primary hits for the shadow pass, shared by both sides.
+    timeTiles(allThreads, w, h, [&](int x, int y) { rt.primaryTile(base, x, y); });
+    const uint64_t hits = countHits(base);
+    std::printf("primary_hits=%llu\n", (unsigned long long)hits);
+    double worstPrimary = 1e30, worstShadow = 1e30;
+    for (int T : threadCounts) {
+        Result rp, ep, rs, es, esSurf;
+        for (int r = 0; r < repeat; ++r) {
+            rp.ms = std::min(rp.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fr, x, y); }));
+            ep.ms = std::min(ep.ms, timeTiles(T, w, h, [&](int x, int y) { em->primaryTile(fe, x, y); }));
+            rs.ms = std::min(rs.ms, timeTiles(T, w, h, [&](int x, int y) { rt.shadowTile(fr, base, x, y); }));
+            esSurf.ms = std::min(esSurf.ms, timeTiles(T, w, h, [&](int x, int y) { em->shadowTile(fe, base, x, y, false); }));
+            es.ms = std::min(es.ms, timeTiles(T, w, h, [&](int x, int y) { em->shadowTile(fe, base, x, y, true); }));
+        }
+        rp.rays = ep.rays = uint64_t(w) * h;
+        rs.rays = es.rays = esSurf.rays = hits;
+        // Embree's better shadow orientation is the peer.
+        const Result& esBest = es.ms <= esSurf.ms ? es : esSurf;
+        std::printf("threads=%d primary_mrays: rtfact=%.2f embree=%.2f ratio=%.3f\n", T, rp.mrays(), ep.mrays(),
+                    rp.mrays() / ep.mrays());
+        std::printf("threads=%d shadow_mrays: rtfact=%.2f embree=%.2f (from light %.2f, to light %.2f) ratio=%.3f\n", T,
+                    rs.mrays(), esBest.mrays(), es.mrays(), esSurf.mrays(), rs.mrays() / esBest.mrays());
+        worstPrimary = std::min(worstPrimary, rp.mrays() / ep.mrays());
+        worstShadow = std::min(worstShadow, rs.mrays() / esBest.mrays());
+    }
+    // Agreement of the two tracers (a sanity check, not a timing).
+    size_t hitDiff = 0, litDiff = 0;
+    for (size_t i = 0; i < fr.t.size(); ++i) {
+        hitDiff += (fr.t[i] < kInfinity) != (fe.t[i] < kInfinity);
+        litDiff += fr.lit[i] != fe.lit[i];
+    }
+    std::printf("agreement: primary_hit_diff_pixels=%zu shadow_diff_pixels=%zu\n", hitDiff, litDiff);
+    const int last = int(threadCounts.size()) - 1;
+    std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\nratio_build=%.3f\n", worstPrimary, worstShadow,
+                rtBuild[last] / emBuild[last]);
+    std::printf("(ratios: RTfact/Embree throughput, the worse of 1 and %d threads; build: RTfact/Embree time at %d threads, lower is better)\n",
+                allThreads, threadCounts[last]);
+    return 0;
+}
+
+}  // namespace
+
+int benchMesh(int argc, char** argv) {
+    CLI::App app{"RTfact vs Embree on a mesh: BVH build, primary and shadow rays", "rtfact-bench mesh"};
+    std::string file, eye, at, up, size = "1024x1024";
+    float fov = 45.0f;
+    int threads = 0, packet = 256, repeat = 3;
+    app.add_option("FILE", file, "Mesh file")->required();
+    app.add_option("--eye", eye, "Camera position x,y,z");
+    app.add_option("--at", at, "Camera target x,y,z");
+    app.add_option("--up", up, "Camera up x,y,z");
+    app.add_option("--fov", fov, "Vertical field of view (degrees)")->capture_default_str();
+    app.add_option("--threads", threads, "All-threads figure uses this many (0: all cores)")->capture_default_str();
+    app.add_option("--size", size, "Image size WxH")->capture_default_str();
+    app.add_option("--packet", packet, "RTfact packet size: 16, 64 or 256")->capture_default_str()->check(CLI::IsMember({16, 64, 256}));
+    app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")->capture_default_str()->check(CLI::Range(1, 100));
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    int w = 1024, h = 1024;
+    if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 16384 || h > 16384 || w % 16 || h % 16)
+        throw Error("", "--size: expected WxH, multiples of 16 in 16..16384");
+    const Mesh mesh = loadMesh(file);
+    Setup setup;
+    const AABB box = mesh.bounds();
+    CameraFrame frame = fitCamera(box, fov, float(w) / float(h));
+    if (!eye.empty()) frame.eye = parseV(eye, "--eye");
+    if (!at.empty()) frame.at = parseV(at, "--at");
+    if (!up.empty()) frame.up = parseV(up, "--up");
+    frame.fovDeg = fov;
+    setup.cam = PinholeCamera(frame, w, h);
+    // The light sits above and beside the camera, so shadows fall visibly.
+    const float r = length(box.extent());
+    setup.light = frame.eye + normalize(frame.up) * r - normalize(cross(frame.at - frame.eye, frame.up)) * (0.7f * r);
+    setup.triNormal.resize(mesh.triangles());
+    for (size_t i = 0; i < mesh.triangles(); ++i) {
+        const Vec3f a = mesh.positions[mesh.indices[3 * i]], b = mesh.positions[mesh.indices[3 * i + 1]],
+                    c = mesh.positions[mesh.indices[3 * i + 2]];
+        setup.triNormal[i] = normalize(cross(b - a, c - a));
+    }
+    const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat);
+    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat);
+    return run<256>(file, mesh, setup, w, h, all, repeat);
 }
 
 }  // namespace rtfact::bench
