@@ -82,3 +82,26 @@ struct SphereScene {
 static_assert(GeometryScene<SphereScene>);
 
 }  // namespace rtfact
+
+// The sphere scene is the core's own model of the generic pieces above it.
+#include "core/accel/kdtree_intersector.h"
+#include "core/concepts/integrator.h"
+#include "core/concepts/renderer.h"
+#include "core/render/direct_light_integrator.h"
+#include "core/render/eyelight_integrator.h"
+#include "core/render/framebuffer.h"
+#include "core/render/jittered_sampler.h"
+#include "core/render/pinhole_camera.h"
+#include "core/render/pixel_center_sampler.h"
+#include "core/render/ray_tracing_renderer.h"
+
+namespace rtfact {
+static_assert(Intersector<BVHIntersector<SphereIntersector>, BVH<Sphere>>);
+static_assert(Intersector<KdTreeIntersector<SphereIntersector>, KdTree<Sphere>>);
+static_assert(Integrator<EyeLightIntegrator, SphereScene>);
+static_assert(Integrator<DirectLightIntegrator, SphereScene>);
+static_assert(Renderer<RayTracingRenderer<PixelCenterSampler, EyeLightIntegrator>, SphereScene, PinholeCamera,
+                       RGBAFramebuffer>);
+static_assert(Renderer<RayTracingRenderer<JitteredSampler, DirectLightIntegrator>, SphereScene, PinholeCamera,
+                       RGBAFramebuffer>);
+}  // namespace rtfact
