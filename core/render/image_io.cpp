@@ -42,15 +42,15 @@ std::string tempPathFor(const std::string& path) {
 }  // namespace
 
 void checkImageWritable(const std::string& path) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw Error(path, "output path is a directory");
     const std::string ext = lowerExt(path);
     if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff" && ext != ".jpg" && ext != ".jpeg" &&
         ext != ".hdr")
         throw Error(path, "unsupported image format '" + ext + "' (use .png, .exr, .tif, .jpg)");
     fs::path dir = fs::path(path).parent_path();
     if (dir.empty()) dir = ".";
-    std::error_code ec;
     if (!fs::is_directory(dir, ec)) throw Error(path, "output directory does not exist");
-    if (fs::is_directory(path, ec)) throw Error(path, "output path is a directory");
     if (access(dir.c_str(), W_OK) != 0) throw Error(path, "output directory is not writable");
 }
 
