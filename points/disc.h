@@ -1,0 +1,66 @@
+// Disc: one splat (centre, radius, octahedral-quantised normal, RGBA8 colour) in 24
+// bytes, so that the cloud plus its LoD tree stays under 40 bytes per point. The alpha
+// byte carries the LoD level (0 for input points, subtree height for representatives).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/concepts/primitive.h"
+
+namespace rtfact::points {
+
+// Octahedral normal encoding in 2 x 16 bits (max error ~0.005 degrees).
+inline uint32_t encodeNormal(Vec3f n) {
+    const float s = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
+    if (!(s > 0)) return encodeNormal({0, 0, 1});
+    float u = n.x / s, v = n.y / s;
+    if (n.z < 0) {
+        const float ou = u, ov = v;
+        u = (1.0f - std::fabs(ov)) * (ou >= 0 ? 1.0f : -1.0f);
+        v = (1.0f - std::fabs(ou)) * (ov >= 0 ? 1.0f : -1.0f);
+    }
+    auto q = [](float x) { return uint32_t(std::lround((std::clamp(x, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f)); };
+    return q(u) | (q(v) << 16);
+}
+inline Vec3f decodeNormal(uint32_t e) {
+    const float u = float(e & 0xffffu) * (2.0f / 65535.0f) - 1.0f;
+    const float v = float(e >> 16) * (2.0f / 65535.0f) - 1.0f;
+    Vec3f n(u, v, 1.0f - std::fabs(u) - std::fabs(v));
+    if (n.z < 0) {
+        n.x = (1.0f - std::fabs(v)) * (u >= 0 ? 1.0f : -1.0f);
+        n.y = (1.0f - std::fabs(u)) * (v >= 0 ? 1.0f : -1.0f);
+    }
+    return normalize(n);
+}
+inline uint32_t packRGBA(Vec3f c, uint8_t a) {
+    auto b = [](float x) { return uint32_t(std::lround(std::clamp(x, 0.0f, 1.0f) * 255.0f)); };
+    return b(c.x) | (b(c.y) << 8) | (b(c.z) << 16) | (uint32_t(a) << 24);
+}
+inline Vec3f unpackRGB(uint32_t c) {
+    return Vec3f(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) * (1.0f / 255.0f);
+}
+
+struct Disc {
+    Vec3f center;
+    float radius = 0;
+    uint32_t normal = 0;  // octahedral
+    uint32_t rgba = 0;    // colour, alpha = LoD level
+
+    Vec3f n() const { return decodeNormal(normal); }
+    uint8_t level() const { return uint8_t(rgba >> 24); }
+    // Tight box of a disc: along axis a it reaches r * sqrt(1 - n_a^2).
+    AABB bounds() const {
+        const Vec3f nn = n();
+        const Vec3f e(radius * std::sqrt(std::max(0.0f, 1.0f - nn.x * nn.x)),
+                      radius * std::sqrt(std::max(0.0f, 1.0f - nn.y * nn.y)),
+                      radius * std::sqrt(std::max(0.0f, 1.0f - nn.z * nn.z)));
+        // Quantisation of the normal: widen slightly so the box surely contains the disc.
+        const Vec3f pad = e + Vec3f(radius * 1e-3f);
+        return {center - pad, center + pad};
+    }
+};
+static_assert(sizeof(Disc) == 24);
+static_assert(Primitive<Disc>);
+
+}  // namespace rtfact::points

@@ -1,0 +1,134 @@
+// LoDKdTreeBuilder: see lod_kdtree.h.
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/util/error.h"
+#include "points/lod_kdtree.h"
+
+namespace rtfact::points {
+
+namespace {
+
+// Area-weighted sums of a subtree, from which its representative disc is made.
+struct Agg {
+    double w = 0;
+    double c[3] = {0, 0, 0};
+    double n[3] = {0, 0, 0};
+    double col[3] = {0, 0, 0};
+    AABB box;        // bounds of all discs
+    int height = 0;  // leaf = 1
+};
+
+struct Ctx {
+    LoDKdTree* tree;
+    Disc* base;
+    size_t leafSize;
+    std::vector<std::pair<size_t, uint32_t>> desc;  // subtree node counts (without the root) per size
+
+    uint32_t descendants(size_t n) const {
+        for (const auto& [k, v] : desc)
+            if (k == n) return v;
+        return 0;
+    }
+    uint32_t computeDesc(size_t n) {
+        for (const auto& [k, v] : desc)
+            if (k == n) return v;
+        const uint32_t v = n <= leafSize ? 0u : 2u + computeDesc(n / 2) + computeDesc(n - n / 2);
+        desc.emplace_back(n, v);
+        return v;
+    }
+};
+
+Disc makeRep(const Agg& a, float radius) {
+    Disc r;
+    const double iw = a.w > 0 ? 1.0 / a.w : 0.0;
+    r.center = Vec3f(float(a.c[0] * iw), float(a.c[1] * iw), float(a.c[2] * iw));
+    Vec3f n(float(a.n[0]), float(a.n[1]), float(a.n[2]));
+    const float len = length(n);
+    r.normal = encodeNormal(len > 0 ? n / len : Vec3f(0, 0, 1));
+    r.radius = radius;
+    r.rgba = packRGBA(Vec3f(float(a.col[0] * iw), float(a.col[1] * iw), float(a.col[2] * iw)), uint8_t(std::min(a.height, 255)));
+    return r;
+}
+
+Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t next) {
+    LoDKdTree& t = *ctx.tree;
+    Agg a;
+    if (n <= ctx.leafSize) {
+        t.nodes[slot] = KdNode::leaf(uint32_t(d - ctx.base), uint32_t(n));
+        for (size_t i = 0; i < n; ++i) {
+            const double w = double(d[i].radius) * d[i].radius + 1e-30;
+            const Vec3f nn = d[i].n(), col = unpackRGB(d[i].rgba);
+            for (int k = 0; k < 3; ++k) {
+                a.c[k] += w * d[i].center[k];
+                a.n[k] += w * nn[k];
+                a.col[k] += w * col[k];
+            }
+            a.w += w;
+            a.box.extend(d[i].bounds());
+        }
+        a.height = 1;
+        Disc rep = makeRep(a, 0.0f);
+        float r = 0;
+        for (size_t i = 0; i < n; ++i) r = std::max(r, length(d[i].center - rep.center) + d[i].radius);
+        rep.radius = r * 1.0001f + 1e-7f;
+        t.reps[slot] = rep;
+        return a;
+    }
+    const int axis = cell.maxAxis();
+    const size_t half = n / 2;
+    std::nth_element(d, d + half, d + n, [axis](const Disc& x, const Disc& y) { return x.center[axis] < y.center[axis]; });
+    const float split = d[half].center[axis];
+    AABB lcell = cell, rcell = cell;
+    lcell.hi[axis] = split;
+    rcell.lo[axis] = split;
+    const uint32_t left = next;
+    t.nodes[slot] = KdNode::inner(axis, split, left);
+    const uint32_t lnext = next + 2, rnext = lnext + ctx.descendants(half);
+    Agg la, ra;
+    auto bl = [&] { la = buildNode(ctx, d, half, lcell, left, lnext); };
+    auto br = [&] { ra = buildNode(ctx, d + half, n - half, rcell, left + 1, rnext); };
+    if (n >= 8192) tbb::parallel_invoke(bl, br);
+    else {
+        bl();
+        br();
+    }
+    t.planes[(left - 1) / 2] = {la.box.hi[axis], ra.box.lo[axis]};
+    a.w = la.w + ra.w;
+    for (int k = 0; k < 3; ++k) {
+        a.c[k] = la.c[k] + ra.c[k];
+        a.n[k] = la.n[k] + ra.n[k];
+        a.col[k] = la.col[k] + ra.col[k];
+    }
+    a.box = merge(la.box, ra.box);
+    a.height = std::max(la.height, ra.height) + 1;
+    Disc rep = makeRep(a, 0.0f);
+    const Disc &lr = t.reps[left], &rr = t.reps[left + 1];
+    const float r = std::max(length(lr.center - rep.center) + lr.radius, length(rr.center - rep.center) + rr.radius);
+    rep.radius = r * 1.0001f + 1e-7f;
+    t.reps[slot] = rep;
+    return a;
+}
+
+}  // namespace
+
+LoDKdTree LoDKdTreeBuilder::build(std::vector<Disc> discs) const {
+    LoDKdTree t;
+    if (discs.empty()) throw Error("", "cannot build a point tree over no points");
+    if (discs.size() >= (size_t(1) << 29)) throw Error("", "too many points for one tree (limit 2^29)");
+    Ctx ctx{&t, discs.data(), size_t(std::max(1, maxLeafSize)), {}};
+    const uint32_t total = 1 + ctx.computeDesc(discs.size());
+    t.nodes.resize(total);
+    t.reps.resize(total);
+    t.planes.resize((total - 1) / 2);
+    AABB cell;
+    for (const Disc& d : discs) cell.extend(d.center);
+    const Agg a = buildNode(ctx, discs.data(), discs.size(), cell, 0, 1);
+    t.box = a.box;
+    t.elems = std::move(discs);
+    return t;
+}
+
+}  // namespace rtfact::points

@@ -1,0 +1,65 @@
+// LoDKdTreeIntersector<ElemIsect>: the core's generic kd-tree traversal with two hooks:
+// children's cells clipped to their real extent (discs reach across split planes), and
+// level-of-detail cuts: when a node's representative disc is smaller than the ray
+// footprint at its distance times `quality`, the packet intersects that disc instead of
+// descending. The footprint is the camera's cone, width(t) = base + slope * t, measured
+// from the packet's first active ray origin (exact for pinhole packets, which share it).
+#pragma once
+#include <array>
+
+#include "core/accel/kdtree_intersector.h"
+#include "core/concepts/camera.h"
+#include "points/lod_kdtree.h"
+
+namespace rtfact::points {
+
+template <class ElemIsect>
+struct LoDNodeIntersector {
+    ElemIsect elem{};
+    const Disc* reps = nullptr;
+    const std::array<float, 2>* planes = nullptr;
+    RayCone cone{};
+    float quality = 1.0f;  // 0: full detail
+    template <int N>
+    using Hit = typename ElemIsect::template Hit<N>;
+
+    void bind(const LoDKdTree& t) {
+        reps = t.reps.data();
+        planes = t.planes.data();
+    }
+
+    template <HitData D, int N>
+    RTFACT_INLINE void intersect(const Disc& d, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit, int firstChunk) const {
+        elem.template intersect<D>(d, id, rays, hit, firstChunk);
+    }
+
+    template <HitData D, class Tree, int N>
+    RTFACT_INLINE bool innerNode(const Tree&, uint32_t node, const AABB&, const RayPacket<N>& rays, Hit<N>& hit,
+                                 int firstChunk) const {
+        if (quality <= 0.0f) return false;
+        const Disc& r = reps[node];
+        const int lane = firstChunk * Packet<N>::W;
+        const Vec3f o(rays.org.x[lane], rays.org.y[lane], rays.org.z[lane]);
+        const float dist = std::max(length(r.center - o) - r.radius, 0.0f);
+        if (2.0f * r.radius > quality * (cone.base + cone.slope * dist)) return false;
+        elem.template intersect<D>(r, uint32_t(-int32_t(node) - 2), rays, hit, firstChunk);
+        return true;
+    }
+
+    template <class Tree>
+    RTFACT_INLINE void childCells(const Tree& tree, uint32_t node, const AABB& cell, AABB& lo, AABB& hi) const {
+        const KdNode& nd = tree.nodes[node];
+        const int axis = nd.axis();
+        const uint32_t left = nd.left();
+        const std::array<float, 2>& p = planes[(left - 1) >> 1];
+        lo = cell;
+        hi = cell;
+        lo.hi[axis] = std::min(cell.hi[axis], p[0]);
+        hi.lo[axis] = std::max(cell.lo[axis], p[1]);
+    }
+};
+
+template <class ElemIsect>
+using LoDKdTreeIntersector = KdTreeIntersector<LoDNodeIntersector<ElemIsect>>;
+
+}  // namespace rtfact::points

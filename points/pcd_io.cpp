@@ -1,0 +1,239 @@
+// PCD through PCL: the header is parsed and checked against the file size here first
+// (PCL trusts lying headers), then PCL reads the body (ascii, binary, LZF compressed).
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/pcd_io.h>
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "core/util/error.h"
+#include "points/point_cloud_io.h"
+#include "points/point_cloud_io_detail.h"
+
+namespace rtfact::points {
+using namespace detail;
+
+namespace {
+
+struct PcdHeader {
+    std::vector<std::string> fields;
+    std::vector<int> sizes, counts;
+    std::vector<char> types;
+    uint64_t width = 0, height = 1, points = 0;
+    bool havePoints = false;
+    std::string data;
+    double viewpoint[7] = {0, 0, 0, 1, 0, 0, 0};
+    size_t bodyOffset = 0;
+};
+
+PcdHeader parsePcdHeader(const MappedFile& f) {
+    const std::string& file = f.name;
+    PcdHeader h;
+    size_t pos = 0;
+    bool haveData = false;
+    while (pos < f.size && !haveData) {
+        size_t eol = pos;
+        while (eol < f.size && f.data[eol] != '\n') ++eol;
+        if (eol - pos > 65536) throw Error(file, "PCD header line too long (not a PCD file?)");
+        std::string line(f.data + pos, eol - pos);
+        pos = std::min(eol + 1, f.size);
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream ls(line);
+        std::string kw;
+        ls >> kw;
+        auto readCount = [&](uint64_t& v) {
+            std::string t;
+            ls >> t;
+            if (t.empty() || t[0] == '-' || t.find_first_not_of("0123456789") != std::string::npos || t.size() > 15)
+                throw Error(file, "bad PCD " + kw + " value '" + t + "'");
+            v = std::stoull(t);
+        };
+        if (kw == "VERSION") continue;
+        if (kw == "FIELDS" || kw == "COLUMNS") {
+            std::string s;
+            while (ls >> s) h.fields.push_back(s);
+        } else if (kw == "SIZE") {
+            int s;
+            while (ls >> s) {
+                if (s != 1 && s != 2 && s != 4 && s != 8) throw Error(file, "bad PCD SIZE " + std::to_string(s));
+                h.sizes.push_back(s);
+            }
+        } else if (kw == "TYPE") {
+            std::string s;
+            while (ls >> s) {
+                if (s != "F" && s != "I" && s != "U") throw Error(file, "bad PCD TYPE '" + s + "'");
+                h.types.push_back(s[0]);
+            }
+        } else if (kw == "COUNT") {
+            int s;
+            while (ls >> s) {
+                if (s < 1 || s > 4096) throw Error(file, "bad PCD COUNT " + std::to_string(s));
+                h.counts.push_back(s);
+            }
+        } else if (kw == "WIDTH") readCount(h.width);
+        else if (kw == "HEIGHT") readCount(h.height);
+        else if (kw == "POINTS") { readCount(h.points); h.havePoints = true; }
+        else if (kw == "VIEWPOINT") {
+            for (double& v : h.viewpoint) ls >> v;
+        } else if (kw == "DATA") {
+            ls >> h.data;
+            haveData = true;
+        } else {
+            throw Error(file, "unexpected PCD header line '" + line.substr(0, 64) + "'");
+        }
+    }
+    if (!haveData) throw Error(file, "PCD header has no DATA line (truncated or not a PCD file)");
+    h.bodyOffset = pos;
+    if (h.fields.empty()) throw Error(file, "PCD header has no FIELDS");
+    if (h.counts.empty()) h.counts.assign(h.fields.size(), 1);
+    if (h.sizes.size() != h.fields.size() || h.types.size() != h.fields.size() || h.counts.size() != h.fields.size())
+        throw Error(file, "PCD header: FIELDS, SIZE, TYPE and COUNT have different lengths");
+    if (!h.havePoints) h.points = h.width * h.height;
+    if (h.width > (uint64_t(1) << 40) || h.height > (uint64_t(1) << 40) || h.width * h.height != h.points)
+        throw Error(file, "PCD header: WIDTH x HEIGHT (" + std::to_string(h.width) + " x " + std::to_string(h.height) +
+                              ") differs from POINTS " + std::to_string(h.points));
+    if (h.data != "ascii" && h.data != "binary" && h.data != "binary_compressed")
+        throw Error(file, "unknown PCD DATA '" + h.data + "'");
+    return h;
+}
+
+size_t rowSize(const PcdHeader& h) {
+    size_t s = 0;
+    for (size_t i = 0; i < h.fields.size(); ++i) s += size_t(h.sizes[i]) * size_t(h.counts[i]);
+    return s;
+}
+
+// The size checks PCL does not do.
+void validateBody(const MappedFile& f, const PcdHeader& h) {
+    const std::string& file = f.name;
+    if (h.points == 0) throw Error(file, "empty point cloud (POINTS 0)");
+    const size_t remaining = f.size - h.bodyOffset;
+    const size_t row = rowSize(h);
+    if (h.data == "ascii") {
+        size_t values = 0;
+        for (int c : h.counts) values += size_t(c);
+        if (h.points > remaining / (2 * values))
+            throw Error(file, "PCD header declares " + std::to_string(h.points) + " points but the file is too small");
+    } else if (h.data == "binary") {
+        if (h.points > remaining / row)
+            throw Error(file, "PCD header declares " + std::to_string(h.points) + " points (" + std::to_string(h.points * row) +
+                                  " bytes) but only " + std::to_string(remaining) + " bytes follow the header");
+    } else {
+        if (remaining < 8) throw Error(file, "PCD compressed body truncated (no size words)");
+        uint32_t csize, usize;
+        std::memcpy(&csize, f.data + h.bodyOffset, 4);
+        std::memcpy(&usize, f.data + h.bodyOffset + 4, 4);
+        if (csize > remaining - 8)
+            throw Error(file, "PCD compressed block of " + std::to_string(csize) + " bytes runs past the end of the file");
+        if (uint64_t(usize) != h.points * row)
+            throw Error(file, "PCD uncompressed size " + std::to_string(usize) + " differs from POINTS x row size " +
+                                  std::to_string(h.points * row));
+        // LZF expands at most 8x + a little; anything more is a lying header.
+        if (uint64_t(usize) > uint64_t(csize) * 9 + 64) throw Error(file, "PCD uncompressed size is implausible for the compressed block");
+    }
+}
+
+}  // namespace
+
+std::optional<PointFileInfo> probePcd(const std::string& file) {
+    MappedFile f(file);
+    const PcdHeader h = parsePcdHeader(f);
+    PointFileInfo info;
+    info.format = "pcd " + h.data;
+    info.points = h.points;
+    info.properties = h.fields;
+    return info;
+}
+
+PointCloud loadPcd(const std::string& file) {
+    PcdHeader h;
+    {
+        MappedFile f(file);
+        h = parsePcdHeader(f);
+        validateBody(f, h);
+    }
+    pcl::PCLPointCloud2 c2;
+    Eigen::Vector4f origin;
+    Eigen::Quaternionf orient;
+    int version = 0;
+    pcl::PCDReader reader;
+    int rc;
+    try {
+        rc = reader.read(file, c2, origin, orient, version);
+    } catch (const std::exception& e) {
+        throw Error(file, std::string("PCD read failed: ") + e.what());
+    }
+    if (rc < 0) throw Error(file, "PCD body could not be read (truncated or corrupt)");
+    const size_t n = size_t(c2.width) * size_t(c2.height);
+    if (n == 0) throw Error(file, "empty point cloud");
+    if (c2.data.size() < n * c2.point_step) throw Error(file, "PCD body shorter than declared");
+    struct Slot {
+        Attr attr;
+        ScalarType type;
+        size_t offset;
+    };
+    std::vector<Slot> slots;
+    int rgbOffset = -1;
+    bool has[int(Attr::Count)] = {};
+    PointCloud cloud;
+    cloud.format = "pcd " + h.data;
+    for (const auto& fld : c2.fields) {
+        cloud.properties.push_back(fld.name);
+        ScalarType t;
+        switch (fld.datatype) {
+            case pcl::PCLPointField::INT8: t = ScalarType::I8; break;
+            case pcl::PCLPointField::UINT8: t = ScalarType::U8; break;
+            case pcl::PCLPointField::INT16: t = ScalarType::I16; break;
+            case pcl::PCLPointField::UINT16: t = ScalarType::U16; break;
+            case pcl::PCLPointField::INT32: t = ScalarType::I32; break;
+            case pcl::PCLPointField::UINT32: t = ScalarType::U32; break;
+            case pcl::PCLPointField::FLOAT32: t = ScalarType::F32; break;
+            case pcl::PCLPointField::FLOAT64: t = ScalarType::F64; break;
+            default: continue;
+        }
+        if (fld.offset + typeSize(t) > c2.point_step) throw Error(file, "PCD field outside the point record");
+        if ((fld.name == "rgb" || fld.name == "rgba") && typeSize(t) == 4) {
+            rgbOffset = int(fld.offset);
+            continue;
+        }
+        const Attr a = attrOf(fld.name);
+        if (a == Attr::None || a == Attr::R || a == Attr::G || a == Attr::B || has[int(a)]) continue;
+        has[int(a)] = true;
+        slots.push_back({a, t, fld.offset});
+    }
+    if (!has[int(Attr::X)] || !has[int(Attr::Y)] || !has[int(Attr::Z)]) throw Error(file, "PCD points lack x, y or z");
+    const bool hasN = has[int(Attr::NX)] && has[int(Attr::NY)] && has[int(Attr::NZ)];
+    PointSink sink;
+    sink.reserve(n, hasN, rgbOffset >= 0, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
+    for (size_t i = 0; i < n; ++i) {
+        const char* rec = reinterpret_cast<const char*>(c2.data.data()) + i * c2.point_step;
+        for (const Slot& s : slots) {
+            const double x = readScalar(rec + s.offset, s.type, false);
+            switch (s.attr) {
+                case Attr::X: sink.pos[i][0] = x; break;
+                case Attr::Y: sink.pos[i][1] = x; break;
+                case Attr::Z: sink.pos[i][2] = x; break;
+                case Attr::NX: if (hasN) sink.nrm[i].x = float(x); break;
+                case Attr::NY: if (hasN) sink.nrm[i].y = float(x); break;
+                case Attr::NZ: if (hasN) sink.nrm[i].z = float(x); break;
+                case Attr::Radius: sink.rad[i] = float(x); break;
+                case Attr::Intensity: sink.inten[i] = float(x); break;
+                default: break;
+            }
+        }
+        if (rgbOffset >= 0) {
+            uint32_t packed;  // 0x00RRGGBB whatever the declared type (F or U)
+            std::memcpy(&packed, rec + rgbOffset, 4);
+            sink.col[i] = {uint8_t(packed >> 16), uint8_t(packed >> 8), uint8_t(packed)};
+        }
+    }
+    sink.finish(file, cloud);
+    const double vp[3] = {h.viewpoint[0], h.viewpoint[1], h.viewpoint[2]};
+    cloud.viewpoint = Vec3f(float(vp[0] - cloud.origin[0]), float(vp[1] - cloud.origin[1]), float(vp[2] - cloud.origin[2]));
+    cloud.hasViewpoint = true;
+    return cloud;
+}
+
+}  // namespace rtfact::points

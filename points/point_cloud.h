@@ -1,0 +1,34 @@
+// PointCloud: what the loaders produce and the preparation step completes. Plain
+// arrays (structure of arrays) so that PCL stays out of every header but a few .cpp.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/math/aabb.h"
+
+namespace rtfact::points {
+
+struct PointCloud {
+    std::vector<Vec3f> positions;
+    std::vector<Vec3f> normals;                   // empty: none in the file
+    std::vector<std::array<uint8_t, 3>> colors;   // empty: none
+    std::vector<float> radii;                     // empty: none
+    std::vector<float> intensities;               // empty: none
+    std::array<double, 3> origin{0, 0, 0};        // subtracted (in double) from the file's coordinates
+    Vec3f viewpoint{0, 0, 0};                     // sensor position (PCD VIEWPOINT), after the shift
+    bool hasViewpoint = false;
+    size_t droppedNonFinite = 0;                  // points with NaN/inf coordinates dropped on load
+    std::string format;                           // e.g. "ply binary_little_endian"
+    std::vector<std::string> properties;          // property names found in the file
+
+    size_t size() const { return positions.size(); }
+    AABB bounds() const {
+        AABB b;
+        for (const Vec3f& p : positions) b.extend(p);
+        return b;
+    }
+};
+
+}  // namespace rtfact::points

@@ -1,0 +1,51 @@
+// Internals shared by the point cloud loaders (not part of the public interface).
+#pragma once
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "points/point_cloud.h"
+#include "points/point_cloud_io.h"
+
+namespace rtfact::points::detail {
+
+// Read-only memory map of a whole file.
+struct MappedFile {
+    explicit MappedFile(const std::string& file);
+    ~MappedFile();
+    MappedFile(const MappedFile&) = delete;
+    MappedFile& operator=(const MappedFile&) = delete;
+    std::string name;
+    const char* data = nullptr;
+    size_t size = 0;
+};
+
+enum class ScalarType { I8, U8, I16, U16, I32, U32, F32, F64 };
+int typeSize(ScalarType t);
+std::optional<ScalarType> parseType(const std::string& s);
+double readScalar(const char* p, ScalarType t, bool bigEndian);
+
+enum class Attr { None, X, Y, Z, NX, NY, NZ, R, G, B, Radius, Intensity, Count };
+Attr attrOf(const std::string& name);
+uint8_t colorByte(double v, ScalarType t);
+
+// Decoded points before the finite check and the origin shift.
+struct PointSink {
+    std::vector<std::array<double, 3>> pos;
+    std::vector<Vec3f> nrm;
+    std::vector<std::array<uint8_t, 3>> col;
+    std::vector<float> rad, inten;
+    void reserve(size_t n, bool normals, bool colors, bool radius, bool intensity);
+    // Drops non-finite points, shifts the origin, moves everything into `out`; throws
+    // when nothing is left.
+    void finish(const std::string& file, PointCloud& out);
+};
+
+}  // namespace rtfact::points::detail
+
+namespace rtfact::points {
+std::optional<PointFileInfo> probePly(const std::string& file);
+std::optional<PointFileInfo> probePcd(const std::string& file);
+std::optional<PointFileInfo> probeXyz(const std::string& file);
+}  // namespace rtfact::points

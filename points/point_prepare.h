@@ -1,0 +1,46 @@
+// Preparing a loaded cloud for splatting: normals (from the file or estimated with
+// PCL's multi-threaded k-NN NormalEstimationOMP, oriented towards the sensor or camera)
+// and per-point radii from the local spacing (distance to the k-th nearest neighbour
+// times a factor, so that neighbouring discs overlap and close the surface).
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "points/disc.h"
+#include "points/point_cloud.h"
+
+namespace rtfact::points {
+
+struct PrepareOptions {
+    std::string normals = "auto";  // auto: from the file if present, else estimate | estimate | file
+    int normalK = 16;
+    float radius = 0.0f;        // > 0: the same radius for every point
+    float radiusFactor = 1.0f;  // times the spacing estimate (or times the file's radii)
+    int radiusK = 4;            // neighbour whose distance is the spacing
+    std::optional<Vec3f> viewpoint;  // where normals should face when there is no sensor position
+    int threads = 0;                 // 0: all cores
+};
+
+struct PrepareReport {
+    double normalsMs = 0, radiusMs = 0;
+    bool estimatedNormals = false, estimatedRadii = false;
+};
+
+// Fills cloud.normals and cloud.radii (throws rtfact::Error on impossible requests,
+// e.g. --normals file for a file without normals).
+PrepareReport preparePointCloud(PointCloud& cloud, const PrepareOptions& opt, const std::string& file);
+
+// Normal estimation alone (k nearest neighbours, PCA), oriented towards `viewpoint`.
+std::vector<Vec3f> estimateNormals(const std::vector<Vec3f>& positions, int k, Vec3f viewpoint, int threads = 0);
+// Distance from each point to its k-th nearest neighbour (0 when the cloud has <= k points).
+std::vector<float> neighbourSpacing(const std::vector<Vec3f>& positions, int k);
+
+enum class ColorMode { Rgb, Intensity, Lod, Normal };
+ColorMode parseColorMode(const std::string& s);
+
+// Discs from a prepared cloud; the colour is the point colour (rgb), the normalised
+// intensity (intensity) or white (lod/normal: colours computed at shading time).
+std::vector<Disc> makeDiscs(const PointCloud& cloud, ColorMode mode);
+
+}  // namespace rtfact::points

@@ -1,0 +1,89 @@
+// PointScene: a point cloud as a GeometryScene (core/concepts/scene.h), so that the
+// core's generic integrators (eyelight, direct light with shadows) and the AO
+// integrator render it. Hits come from the LoD kd-tree; shading data from the disc or
+// representative disc hit, coloured by the chosen colour mode.
+#pragma once
+#include <atomic>
+#include <memory>
+
+#include "core/concepts/scene.h"
+#include "core/render/tracer.h"
+#include "points/disc_intersector.h"
+#include "points/lod_kdtree_intersector.h"
+#include "points/point_prepare.h"
+
+namespace rtfact::points {
+
+// Distinct colours for LoD levels: 0 = input points (grey), then blue..red as the
+// representative covers larger subtrees.
+inline Vec3f lodLevelColor(int level) {
+    static const Vec3f pal[] = {{0.75f, 0.75f, 0.75f}, {0.2f, 0.35f, 1.0f}, {0.1f, 0.8f, 0.9f}, {0.2f, 0.85f, 0.3f},
+                                {0.9f, 0.9f, 0.2f},    {1.0f, 0.55f, 0.1f}, {1.0f, 0.15f, 0.1f}, {0.9f, 0.2f, 0.9f}};
+    return pal[std::min(level, 7)];
+}
+
+struct PointScene {
+    LoDKdTree tree;
+    Tracer<LoDKdTreeIntersector<DiscIntersector>> tracer;
+    ColorMode colorMode = ColorMode::Rgb;
+    std::shared_ptr<std::atomic<uint64_t>> lodHits = std::make_shared<std::atomic<uint64_t>>(0);
+    template <int N>
+    using Hit = DiscIntersector::Hit<N>;
+
+    void build(std::vector<Disc> discs, const LoDKdTreeBuilder& builder = {}) {
+        tree = builder.build(std::move(discs));
+        tracer.isect.elem.bind(tree);
+    }
+    // Footprint of the camera rays and the LoD quality (0: full detail).
+    void setLoD(RayCone cone, float quality) {
+        tracer.isect.elem.bind(tree);
+        tracer.isect.elem.cone = cone;
+        tracer.isect.elem.quality = quality;
+    }
+    AABB bounds() const { return tree.box; }
+    const Disc& disc(int32_t id) const { return id >= 0 ? tree.elems[size_t(id)] : tree.reps[size_t(-id - 2)]; }
+
+    template <int N>
+    Hit<N> intersect(const RayPacket<N>& rays, const Mask<N>& active) const {
+        return tracer.intersect(tree, rays, active);
+    }
+    template <int N>
+    Mask<N> occluded(const RayPacket<N>& rays, const Mask<N>& active) const {
+        return tracer.occluded(tree, rays, active);
+    }
+    template <int N>
+    SurfacePoint<N> surface(const RayPacket<N>& rays, const Hit<N>& hit, const Mask<N>& valid) const {
+        SurfacePoint<N> sp;
+        sp.p = rays.org + rays.dir * hit.t;
+        Vec3<N> n(Vec3f(0, 0, 1)), col(Vec3f(1.0f));
+        uint64_t reps = 0;
+        for (int i = 0; i < N; ++i) {
+            if (!valid[i]) continue;
+            const int32_t id = hit.id[i];
+            const Disc& d = disc(id);
+            reps += id < 0;
+            Vec3f nn = d.n();
+            Vec3f c;
+            switch (colorMode) {
+                case ColorMode::Normal: c = nn * 0.5f + Vec3f(0.5f); break;
+                case ColorMode::Lod: c = lodLevelColor(id < 0 ? d.level() : 0); break;
+                default: c = unpackRGB(d.rgba); break;
+            }
+            if (dot(nn, rays.dir.lane(i)) > 0) nn = -nn;
+            n.setLane(i, nn);
+            col.setLane(i, c);
+        }
+        if (reps) *lodHits += reps;
+        sp.n = n;
+        sp.ng = n;
+        sp.u = Packet<N>(0.0f);
+        sp.v = Packet<N>(0.0f);
+        sp.color = col;
+        sp.material = Packet<N, int32_t>(0);
+        return sp;
+    }
+};
+static_assert(GeometryScene<PointScene>);
+static_assert(Intersector<LoDKdTreeIntersector<DiscIntersector>, KdTree<Disc>>);
+
+}  // namespace rtfact::points
