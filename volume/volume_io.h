@@ -1,0 +1,48 @@
+// Loading scalar volumes: raw, MetaImage (.mhd/.mha), NRRD (.nrrd/.nhdr, raw or gzip,
+// detached and per-slice data files), NIfTI-1 (.nii/.nii.gz), VTK image data (.vti),
+// DICOM series (a directory) and OpenVDB (.vdb). Every size a header claims is checked
+// against the file before anything is allocated; problems throw rtfact::Error.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "volume/volume_grid.h"
+
+namespace rtfact::volume {
+
+struct VolumeLoadOptions {
+    // Raw files (and overrides for any format where it makes sense).
+    std::optional<std::array<int, 3>> dims;
+    std::string type;            // u8|u16|i16|f32 (raw only)
+    std::string endian = "little";
+    std::optional<Vec3f> spacing;  // overrides the file's spacing
+    uint64_t headerSkip = 0;
+    std::string grid;            // OpenVDB grid name; default the first float grid
+    bool progress = true;
+};
+
+// True for paths this module claims (by extension, or a directory of DICOM files).
+bool looksLikeVolume(const std::string& path);
+VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt = {});
+
+// Parses "X,Y,Z" dims and "sx,sy,sz" spacing; throw rtfact::Error naming `what`.
+std::array<int, 3> parseDims(const std::string& text);
+Vec3f parseSpacing(const std::string& text);
+
+// Largest voxel count a grid may have (indices are 32-bit in the SIMD gathers).
+inline constexpr uint64_t kMaxVoxels = (uint64_t(1) << 31) - 1;
+// Validates dims (positive, product within kMaxVoxels); returns the voxel count.
+uint64_t checkedVoxelCount(const std::string& file, const int64_t dims[3]);
+
+// Writers used by the generators and tests.
+void writeRaw(const std::string& path, const VolumeGrid& g);
+void writeMetaImage(const std::string& mhdPath, const VolumeGrid& g);
+
+// Internals shared by the loader files.
+VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions& opt);
+VolumeGrid loadVTI(const std::string& path, const VolumeLoadOptions& opt);
+VolumeGrid loadVDB(const std::string& path, const VolumeLoadOptions& opt);
+
+}  // namespace rtfact::volume

@@ -1,0 +1,42 @@
+// Fetches two x-adjacent voxels per lane with one 32-bit gather for u8/u16 storage (the
+// grid is padded so the over-read stays in bounds); f32 needs two gathers.
+#pragma once
+#include <cstring>
+#include <type_traits>
+
+#include "core/simd/packet.h"
+
+namespace rtfact::volume {
+
+template <class T, int W>
+RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packet<W>& a, Packet<W>& b) {
+    using namespace simd;
+#if RTFACT_NATIVE_WIDTH >= 16
+    if constexpr (W == 16) {
+        const __m512i g = _mm512_i32gather_epi32((__m512i)idx.c[0], (const void*)base, int(sizeof(T)));
+        if constexpr (sizeof(T) == 1) {
+            a.c[0] = (nvec<float, 16>)_mm512_cvtepi32_ps(_mm512_and_si512(g, _mm512_set1_epi32(0xFF)));
+            b.c[0] = (nvec<float, 16>)_mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(g, 8), _mm512_set1_epi32(0xFF)));
+        } else if constexpr (sizeof(T) == 2) {
+            a.c[0] = (nvec<float, 16>)_mm512_cvtepi32_ps(_mm512_and_si512(g, _mm512_set1_epi32(0xFFFF)));
+            b.c[0] = (nvec<float, 16>)_mm512_cvtepi32_ps(_mm512_srli_epi32(g, 16));
+        } else {
+            a.c[0] = (nvec<float, 16>)_mm512_castsi512_ps(g);
+            b.c[0] = (nvec<float, 16>)_mm512_i32gather_ps(_mm512_add_epi32((__m512i)idx.c[0], _mm512_set1_epi32(1)), (const void*)base, 4);
+        }
+        return;
+    }
+#endif
+    for (int i = 0; i < W; ++i) {
+        const T* p = base + idx[i];
+        if constexpr (std::is_same_v<T, float>) {
+            a[i] = p[0];
+            b[i] = p[1];
+        } else {
+            a[i] = float(p[0]);
+            b[i] = float(p[1]);
+        }
+    }
+}
+
+}  // namespace rtfact::volume
