@@ -4,6 +4,7 @@
 #include <concepts>
 
 #include "core/concepts/material.h"
+#include "core/math/aabb.h"
 #include "core/ray/ray_packet.h"
 
 namespace rtfact {
