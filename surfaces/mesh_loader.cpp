@@ -22,6 +22,7 @@
 #include <vtkPLYReader.h>
 #include <vtkSTLReader.h>
 #include <vtkSmartPointer.h>
+#include <vtkStringOutputWindow.h>
 #include <vtkXMLPolyDataReader.h>
 
 #include "core/util/error.h"
@@ -72,8 +73,22 @@ struct VtkErrors {
     }
 };
 
+// VTK helpers (XML parser, ...) print errors through the global output window; while
+// a file loads that text is swallowed, our observer turns the reader's error into an
+// Error instead.
+struct QuietVtkOutput {
+    vtkSmartPointer<vtkOutputWindow> previous;
+    QuietVtkOutput() {
+        previous = vtkOutputWindow::GetInstance();
+        vtkNew<vtkStringOutputWindow> quiet;
+        vtkOutputWindow::SetInstance(quiet);
+    }
+    ~QuietVtkOutput() { vtkOutputWindow::SetInstance(previous); }
+};
+
 template <class Reader>
 vtkPolyData* runReader(Reader* reader, const std::string& file, VtkErrors& errs) {
+    QuietVtkOutput quiet;
     vtkNew<vtkCallbackCommand> cb;
     cb->SetCallback(&VtkErrors::onEvent);
     cb->SetClientData(&errs);

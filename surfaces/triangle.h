@@ -5,7 +5,8 @@
 // and the sum of its end points, the value of a shared edge is bit-exactly negated in
 // the neighbouring triangle (which walks the edge the other way), whatever FMA
 // contraction the compiler picks, so a ray on a shared edge hits at least one of the
-// two triangles: no cracks. With a common origin (primary rays, shadow rays cast from
+// two triangles: no cracks. Vertices, where the spoke values of a whole fan are
+// rounding noise, are closed by a tiny relative tolerance. With a common origin (primary rays, shadow rays cast from
 // a light) the edge vectors are scalar per triangle and each chunk only needs four dot
 // products.
 #pragma once
@@ -51,7 +52,10 @@ struct TriangleIntersector {
         // Lanes hit when the three edge functions agree in sign and t is in range.
         auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const P& tnum) __attribute__((always_inline)) {
             const P den = e0 + e1 + e2;
-            const auto inside = ((min(min(e0, e1), e2) >= zero) | (max(max(e0, e1), e2) <= zero)) & (den != zero);
+            // A tolerance of 2^-16 of the edge magnitudes closes vertices, where several
+            // near-zero spoke values of one fan may all round to the same side.
+            const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
+            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (den != zero);
             if (none(inside)) return;
             const P inv = P(1.0f) / den;
             const P t = tnum * inv;
