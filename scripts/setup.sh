@@ -32,8 +32,9 @@ rtfact_install_packages() {
 rtfact_build() {
   local jobs
   jobs="$(nproc 2>/dev/null || echo 2)"
-  cmake -S "$RTFACT_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "$@" >"$BUILD_DIR.configure.log" 2>&1 || {
-    cat "$BUILD_DIR.configure.log"
+  mkdir -p "$BUILD_DIR"
+  cmake -S "$RTFACT_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "$@" >"$BUILD_DIR/configure.log" 2>&1 || {
+    cat "$BUILD_DIR/configure.log"
     echo "setup: cmake configure failed" >&2
     return 1
   }

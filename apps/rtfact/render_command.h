@@ -9,6 +9,7 @@
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/render/tile_scheduler.h"
+#include "core/util/memory_budget.h"
 
 namespace rtfact::app {
 
@@ -16,6 +17,9 @@ template <class Integrator, class Scene>
 void renderToFile(const Scene& scene, const Integrator& integrator, const CommonOptions& o, const CameraFrame& frame,
                   Stats& stats) {
     const PinholeCamera cam(frame, o.width, o.height);
+    // Accumulation buffer, resolved copy and 8-bit output.
+    checkMemory(o.out, uint64_t(o.width) * uint64_t(o.height) * 36u, "a " + std::to_string(o.width) + "x" +
+                std::to_string(o.height) + " framebuffer", "use a smaller --size");
     RGBAFramebuffer fb(o.width, o.height);
     const RayTracingRenderer<JitteredSampler, Integrator> renderer{{}, integrator};
     RenderOptions ro;
