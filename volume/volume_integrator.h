@@ -109,6 +109,9 @@ struct VolumeIntegrator {
             tFar = min(tFar, max(t0, t1));
         }
         const P dt(s.dt), invDt(1.0f / s.dt);
+        // Sample k sits at tNear + (k + 1/2) dt, computed directly (not accumulated) so
+        // that skipping and stepping reach bit-identical positions.
+        P kf(0.0f);
         P t = tNear + P(0.5f) * dt;
         Mask<W> alive = act & (tNear <= tFar) & (t < tFar);
         col = Vec3<W>(Vec3f(0.0f));
@@ -142,9 +145,10 @@ struct VolumeIntegrator {
                         const P bound = toFloat(c[a] + select(di[a] > P(0.0f), I(1), I(0))) * P(float(MacrocellGrid::kCell));
                         tExit = min(tExit, (bound - oi[a]) * inv[a]);
                     }
-                    const P kk = -floor(-((tExit - tNear) * invDt - P(0.5f)));
-                    const P tn = max(tNear + (kk + P(0.5f)) * dt, t + dt);
-                    skipAcc += select(empty, (min(tn, tFar) - t) * invDt, P(0.0f));
+                    const P kk = max(-floor(-((tExit - tNear) * invDt - P(0.5f))), kf + P(1.0f));
+                    const P tn = tNear + (kk + P(0.5f)) * dt;
+                    skipAcc += select(empty, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));
+                    kf = select(empty, kk, kf);
                     t = select(empty, tn, t);
                     samp = andNot(alive, empty);
                 }
@@ -173,7 +177,7 @@ struct VolumeIntegrator {
                         // Bisection on [tPrev, t] keeping the bracket around the crossing.
                         P lo = tPrev, hi = t;
                         const Mask<W> prevBelow = prev < isoV;
-                        for (int it = 0; it < 10; ++it) {
+                        for (int it = 0; it < 12; ++it) {
                             const P mid = P(0.5f) * (lo + hi);
                             const P vm = sample<W>(s, clampToGrid<W>(s, oi + di * mid));
                             const Mask<W> sameAsPrev = ~((vm < isoV) ^ prevBelow);
@@ -195,7 +199,8 @@ struct VolumeIntegrator {
                     tPrev = select(samp, t, tPrev);
                     hasPrev = hasPrev | samp;
                 }
-                t = select(samp, t + dt, t);
+                kf = select(samp, kf + P(1.0f), kf);
+                t = select(samp, tNear + (kf + P(0.5f)) * dt, t);
             }
             alive = alive & (t < tFar);
         }
