@@ -11,7 +11,7 @@ struct DiscIntersector {
     template <int N>
     struct Hit {
         Packet<N> t;
-        Packet<N, int32_t> id;  // >= 0: input disc (leaf order); <= -2: representative of node -id-2
+        Packet<N, int32_t> id;  // >= 0: input disc (leaf order); <= -2: representative disc of inner node -id-2
     };
 
     template <HitData D, int N>

@@ -13,13 +13,21 @@
 
 namespace rtfact::points {
 
-struct LoDKdTree : KdTree<Disc> {
-    std::vector<Disc> reps;                    // one per node (leaves included)
-    std::vector<std::array<float, 2>> planes;  // per inner node, at (left child - 1) / 2: {left hi, right lo}
+// What an inner node adds to its 8-byte KdNode: its representative disc and the extent
+// of its children along the split axis. Stored at the node's inner ordinal
+// (left child - 1) / 2, so leaves pay nothing.
+struct LoDInner {
+    Disc rep;
+    float leftHi, rightLo;
+};
+static_assert(sizeof(LoDInner) == 32);
 
-    size_t memoryBytes() const {
-        return KdTree<Disc>::memoryBytes() + reps.size() * sizeof(Disc) + planes.size() * sizeof(planes[0]);
-    }
+struct LoDKdTree : KdTree<Disc> {
+    std::vector<LoDInner> inner;
+
+    static uint32_t innerIndex(const KdNode& n) { return (n.left() - 1) >> 1; }
+    const Disc& rep(uint32_t node) const { return inner[innerIndex(nodes[node])].rep; }
+    size_t memoryBytes() const { return KdTree<Disc>::memoryBytes() + inner.size() * sizeof(LoDInner); }
     double bytesPerPoint() const { return elems.empty() ? 0.0 : double(memoryBytes()) / double(elems.size()); }
 };
 

@@ -19,6 +19,7 @@ struct Agg {
     double col[3] = {0, 0, 0};
     AABB box;        // bounds of all discs
     int height = 0;  // leaf = 1
+    Disc rep;
 };
 
 struct Ctx {
@@ -74,7 +75,7 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         float r = 0;
         for (size_t i = 0; i < n; ++i) r = std::max(r, length(d[i].center - rep.center) + d[i].radius);
         rep.radius = r * 1.0001f + 1e-7f;
-        t.reps[slot] = rep;
+        a.rep = rep;
         return a;
     }
     const int axis = cell.maxAxis();
@@ -95,7 +96,11 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         bl();
         br();
     }
-    t.planes[(left - 1) / 2] = {la.box.hi[axis], ra.box.lo[axis]};
+    LoDInner& in = t.inner[(left - 1) / 2];
+    // Padded: disc bounds may round differently where the compiler contracts to FMA.
+    const float pad = 1e-6f * (std::fabs(la.box.hi[axis]) + std::fabs(ra.box.lo[axis]) + cell.hi[axis] - cell.lo[axis]);
+    in.leftHi = la.box.hi[axis] + pad;
+    in.rightLo = ra.box.lo[axis] - pad;
     a.w = la.w + ra.w;
     for (int k = 0; k < 3; ++k) {
         a.c[k] = la.c[k] + ra.c[k];
@@ -105,10 +110,11 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
     a.box = merge(la.box, ra.box);
     a.height = std::max(la.height, ra.height) + 1;
     Disc rep = makeRep(a, 0.0f);
-    const Disc &lr = t.reps[left], &rr = t.reps[left + 1];
+    const Disc &lr = la.rep, &rr = ra.rep;
     const float r = std::max(length(lr.center - rep.center) + lr.radius, length(rr.center - rep.center) + rr.radius);
     rep.radius = r * 1.0001f + 1e-7f;
-    t.reps[slot] = rep;
+    in.rep = rep;
+    a.rep = rep;
     return a;
 }
 
@@ -121,12 +127,14 @@ LoDKdTree LoDKdTreeBuilder::build(std::vector<Disc> discs) const {
     Ctx ctx{&t, discs.data(), size_t(std::max(1, maxLeafSize)), {}};
     const uint32_t total = 1 + ctx.computeDesc(discs.size());
     t.nodes.resize(total);
-    t.reps.resize(total);
-    t.planes.resize((total - 1) / 2);
+    t.inner.resize((total - 1) / 2);
     AABB cell;
     for (const Disc& d : discs) cell.extend(d.center);
     const Agg a = buildNode(ctx, discs.data(), discs.size(), cell, 0, 1);
     t.box = a.box;
+    const Vec3f pad = Vec3f(1e-6f * (maxComponent(vmax(-a.box.lo, a.box.hi)) + maxComponent(a.box.extent())));
+    t.box.lo -= pad;
+    t.box.hi += pad;
     t.elems = std::move(discs);
     return t;
 }

@@ -16,16 +16,14 @@ namespace rtfact::points {
 template <class ElemIsect>
 struct LoDNodeIntersector {
     ElemIsect elem{};
-    const Disc* reps = nullptr;
-    const std::array<float, 2>* planes = nullptr;
+    const LoDInner* inner = nullptr;
     RayCone cone{};
     float quality = 1.0f;  // 0: full detail
     template <int N>
     using Hit = typename ElemIsect::template Hit<N>;
 
     void bind(const LoDKdTree& t) {
-        reps = t.reps.data();
-        planes = t.planes.data();
+        inner = t.inner.data();
     }
 
     template <HitData D, int N>
@@ -34,15 +32,16 @@ struct LoDNodeIntersector {
     }
 
     template <HitData D, class Tree, int N>
-    RTFACT_INLINE bool innerNode(const Tree&, uint32_t node, const AABB&, const RayPacket<N>& rays, Hit<N>& hit,
+    RTFACT_INLINE bool innerNode(const Tree& tree, uint32_t node, const AABB&, const RayPacket<N>& rays, Hit<N>& hit,
                                  int firstChunk) const {
         if (quality <= 0.0f) return false;
-        const Disc& r = reps[node];
+        const uint32_t idx = LoDKdTree::innerIndex(tree.nodes[node]);
+        const Disc& r = inner[idx].rep;
         const int lane = firstChunk * Packet<N>::W;
         const Vec3f o(rays.org.x[lane], rays.org.y[lane], rays.org.z[lane]);
         const float dist = std::max(length(r.center - o) - r.radius, 0.0f);
         if (2.0f * r.radius > quality * (cone.base + cone.slope * dist)) return false;
-        elem.template intersect<D>(r, uint32_t(-int32_t(node) - 2), rays, hit, firstChunk);
+        elem.template intersect<D>(r, uint32_t(-int32_t(idx) - 2), rays, hit, firstChunk);
         return true;
     }
 
@@ -50,12 +49,11 @@ struct LoDNodeIntersector {
     RTFACT_INLINE void childCells(const Tree& tree, uint32_t node, const AABB& cell, AABB& lo, AABB& hi) const {
         const KdNode& nd = tree.nodes[node];
         const int axis = nd.axis();
-        const uint32_t left = nd.left();
-        const std::array<float, 2>& p = planes[(left - 1) >> 1];
+        const LoDInner& in = inner[LoDKdTree::innerIndex(nd)];
         lo = cell;
         hi = cell;
-        lo.hi[axis] = std::min(cell.hi[axis], p[0]);
-        hi.lo[axis] = std::max(cell.lo[axis], p[1]);
+        lo.hi[axis] = std::min(cell.hi[axis], in.leftHi);
+        hi.lo[axis] = std::max(cell.lo[axis], in.rightLo);
     }
 };
 

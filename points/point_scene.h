@@ -41,7 +41,7 @@ struct PointScene {
         tracer.isect.elem.quality = quality;
     }
     AABB bounds() const { return tree.box; }
-    const Disc& disc(int32_t id) const { return id >= 0 ? tree.elems[size_t(id)] : tree.reps[size_t(-id - 2)]; }
+    const Disc& disc(int32_t id) const { return id >= 0 ? tree.elems[size_t(id)] : tree.inner[size_t(-id - 2)].rep; }
 
     template <int N>
     Hit<N> intersect(const RayPacket<N>& rays, const Mask<N>& active) const {

@@ -1,0 +1,282 @@
+// Disc intersector against an analytic reference; LoD traversal at quality 0 against
+// brute force over all discs (single rays and packets); representative discs cover
+// their subtrees; normal estimation on a plane and a sphere.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/render/pinhole_camera.h"
+#include "points/point_prepare.h"
+#include "points/point_scene.h"
+
+using namespace rtfact;
+using namespace rtfact::points;
+
+namespace {
+
+Vec3f randomUnit(std::mt19937& g) {
+    std::normal_distribution<float> n;
+    for (;;) {
+        Vec3f v(n(g), n(g), n(g));
+        if (length(v) > 1e-3f) return normalize(v);
+    }
+}
+
+// Analytic reference in double: plane hit, inside test.
+bool referenceHit(const Disc& d, Vec3f o, Vec3f dir, double& t) {
+    const Vec3f n = d.n();
+    const double den = double(dir.x) * n.x + double(dir.y) * n.y + double(dir.z) * n.z;
+    if (den == 0) return false;
+    t = ((double(d.center.x) - o.x) * n.x + (double(d.center.y) - o.y) * n.y + (double(d.center.z) - o.z) * n.z) / den;
+    const double px = o.x + t * dir.x - d.center.x, py = o.y + t * dir.y - d.center.y, pz = o.z + t * dir.z - d.center.z;
+    return t > 0 && px * px + py * py + pz * pz <= double(d.radius) * d.radius;
+}
+
+template <int N>
+void checkDiscIntersector(std::mt19937& g, int rounds) {
+    std::uniform_real_distribution<float> u(-1, 1);
+    int hits = 0, checked = 0;
+    for (int r = 0; r < rounds; ++r) {
+        Disc d;
+        d.center = Vec3f(u(g), u(g), u(g)) * 0.3f;
+        d.radius = 0.1f + 0.4f * (u(g) + 1);
+        d.normal = encodeNormal(randomUnit(g));
+        RayPacket<N> rays;
+        for (int i = 0; i < N; ++i) {
+            const Vec3f o = randomUnit(g) * 3.0f;
+            const Vec3f target = d.center + Vec3f(u(g), u(g), u(g)) * d.radius;
+            rays.setLane(i, o, normalize(target - o), 0.0f, kInfinity);
+        }
+        rays.finalize();
+        DiscIntersector::Hit<N> hit;
+        hit.t = rays.tMax;
+        hit.id = Packet<N, int32_t>(-1);
+        DiscIntersector{}.intersect<HitData::Shading>(d, 7u, rays, hit, 0);
+        for (int i = 0; i < N; ++i) {
+            double t;
+            const Vec3f o = rays.org.lane(i), dir = rays.dir.lane(i);
+            const bool ref = referenceHit(d, o, dir, t);
+            // Skip rays grazing the rim, where float and double may disagree.
+            const Vec3f n = d.n();
+            const float tp = dot(d.center - o, n) / dot(dir, n);
+            const float rim = length(o + dir * tp - d.center);
+            if (std::fabs(rim - d.radius) < 1e-4f * d.radius || std::fabs(dot(dir, n)) < 1e-3f) continue;
+            ++checked;
+            ASSERT_EQ(ref, hit.id[i] == 7) << "lane " << i;
+            if (ref) {
+                ++hits;
+                EXPECT_NEAR(hit.t[i], t, 1e-4 * std::max(1.0, t));
+            }
+        }
+    }
+    EXPECT_GT(hits, checked / 4);
+}
+
+}  // namespace
+
+TEST(DiscIntersector, MatchesAnalyticReferenceSingleRay) {
+    std::mt19937 g(1);
+    checkDiscIntersector<1>(g, 3000);
+}
+TEST(DiscIntersector, MatchesAnalyticReferenceNativePacket) {
+    std::mt19937 g(2);
+    checkDiscIntersector<simd::kNativeWidth>(g, 300);
+}
+TEST(DiscIntersector, MatchesAnalyticReferencePacket64) {
+    std::mt19937 g(3);
+    checkDiscIntersector<64>(g, 100);
+}
+
+TEST(DiscEncoding, NormalsRoundTripWithinSmallAngle) {
+    std::mt19937 g(4);
+    for (int i = 0; i < 10000; ++i) {
+        const Vec3f n = randomUnit(g);
+        const Vec3f m = decodeNormal(encodeNormal(n));
+        const double c = std::min(1.0, double(n.x) * m.x + double(n.y) * m.y + double(n.z) * m.z);
+        EXPECT_LT(std::acos(c) * 180.0 / 3.141592653589793, 0.05);
+    }
+}
+
+namespace {
+
+// A random cloud: points on a sphere and in a box, mixed radii and normals.
+std::vector<Disc> randomDiscs(int n, uint32_t seed) {
+    std::mt19937 g(seed);
+    std::uniform_real_distribution<float> u(0, 1);
+    std::vector<Disc> d(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const Vec3f p = i % 2 ? randomUnit(g) : Vec3f(u(g), u(g), u(g)) * 2.0f - Vec3f(1.0f);
+        d[size_t(i)].center = p;
+        d[size_t(i)].radius = 0.01f + 0.06f * u(g);
+        d[size_t(i)].normal = encodeNormal(i % 2 ? p : randomUnit(g));
+        d[size_t(i)].rgba = packRGBA(Vec3f(u(g), u(g), u(g)), 0);
+    }
+    return d;
+}
+
+template <int N>
+void checkAgainstBruteForce(const PointScene& scene, bool commonOrigin, uint32_t seed) {
+    std::mt19937 g(seed);
+    std::uniform_real_distribution<float> u(-1, 1);
+    const auto& discs = scene.tree.elems;
+    int hits = 0;
+    for (int round = 0; round < 40; ++round) {
+        RayPacket<N> rays;
+        const Vec3f eye = randomUnit(g) * 3.0f;
+        for (int i = 0; i < N; ++i) {
+            const Vec3f o = commonOrigin ? eye : Vec3f(u(g), u(g), u(g)) * 1.5f;
+            const Vec3f d = commonOrigin ? normalize(Vec3f(u(g), u(g), u(g)) * 0.8f - eye) : randomUnit(g);
+            rays.setLane(i, o, d, 0.0f, i % 5 == 4 ? 1.5f : kInfinity);
+        }
+        rays.commonOrigin = commonOrigin;
+        rays.finalize();
+        Mask<N> active(true);
+        for (int i = 3; i < N; i += 7) active.set(i, false);  // some inactive lanes (none for N = 1)
+        const auto hit = scene.intersect<N>(rays, active);
+        const Mask<N> occ = scene.occluded<N>(rays, active);
+        for (int i = 0; i < N; ++i) {
+            if (!active[i]) continue;
+            // Brute force with the same element test, single ray.
+            RayPacket<1> r1 = rays.lane(i);
+            r1.finalize();
+            DiscIntersector::Hit<1> h1;
+            h1.t = r1.tMax;
+            h1.id = Packet<1, int32_t>(-1);
+            for (size_t k = 0; k < discs.size(); ++k) DiscIntersector{}.intersect<HitData::Shading>(discs[k], uint32_t(k), r1, h1, 0);
+            const bool bf = int32_t(h1.id) >= 0;
+            ASSERT_EQ(bf, hit.id[i] >= 0) << "lane " << i << " round " << round;
+            EXPECT_EQ(bf, bool(occ[i])) << "occlusion lane " << i;
+            if (bf) {
+                ++hits;
+                EXPECT_EQ(float(h1.t), hit.t[i]);
+            }
+        }
+    }
+    EXPECT_GT(hits, 0);
+}
+
+}  // namespace
+
+class LoDTraversal : public ::testing::TestWithParam<int> {};
+
+TEST_P(LoDTraversal, QualityZeroEqualsBruteForce) {
+    PointScene scene;
+    LoDKdTreeBuilder b;
+    b.maxLeafSize = GetParam();
+    scene.build(randomDiscs(3000, 11), b);
+    scene.setLoD(RayCone{0.0f, 0.01f}, 0.0f);
+    checkAgainstBruteForce<1>(scene, false, 21);
+    checkAgainstBruteForce<1>(scene, true, 22);
+    checkAgainstBruteForce<simd::kNativeWidth>(scene, true, 23);
+    checkAgainstBruteForce<simd::kNativeWidth>(scene, false, 24);
+    checkAgainstBruteForce<64>(scene, true, 25);
+    checkAgainstBruteForce<64>(scene, false, 26);
+}
+INSTANTIATE_TEST_SUITE_P(LeafSizes, LoDTraversal, ::testing::Values(1, 4, 8, 16));
+
+TEST(LoDTree, RepresentativeDiscsCoverTheirSubtrees) {
+    const std::vector<Disc> input = randomDiscs(5000, 31);
+    PointScene scene;
+    scene.build(input);
+    const LoDKdTree& t = scene.tree;
+    ASSERT_EQ(t.elems.size(), input.size());
+    EXPECT_TRUE(t.indices.empty());
+    std::vector<int> seen(t.elems.size(), 0);
+    // Walk the tree collecting each node's element range, then check cover and extents.
+    struct Range { uint32_t first, count; };
+    std::vector<Range> range(t.nodes.size());
+    std::function<Range(uint32_t)> walk = [&](uint32_t node) -> Range {
+        const KdNode& n = t.nodes[node];
+        if (n.isLeaf()) {
+            for (uint32_t i = 0; i < n.count; ++i) ++seen[n.first() + i];
+            return range[node] = {n.first(), n.count};
+        }
+        const Range a = walk(n.left()), b = walk(n.left() + 1);
+        EXPECT_EQ(a.first + a.count, b.first);  // subtrees are contiguous in leaf order
+        const LoDInner& in = t.inner[LoDKdTree::innerIndex(n)];
+        const int axis = n.axis();
+        for (uint32_t i = a.first; i < a.first + a.count; ++i) EXPECT_LE(t.elems[i].bounds().hi[axis], in.leftHi);
+        for (uint32_t i = b.first; i < b.first + b.count; ++i) EXPECT_GE(t.elems[i].bounds().lo[axis], in.rightLo);
+        const Disc& rep = in.rep;
+        for (uint32_t i = a.first; i < b.first + b.count; ++i) {
+            const Disc& d = t.elems[i];
+            EXPECT_LE(length(d.center - rep.center) + d.radius, rep.radius) << "node " << node;
+            EXPECT_TRUE(t.box.contains(d.bounds()));
+        }
+        EXPECT_GE(rep.level(), 2);
+        return range[node] = {a.first, a.count + b.count};
+    };
+    walk(0);
+    for (int s : seen) EXPECT_EQ(s, 1);
+    // Input discs survive (reordered): same multiset of centres.
+    auto key = [](const Disc& d) { return std::make_tuple(d.center.x, d.center.y, d.center.z, d.radius); };
+    std::vector<std::tuple<float, float, float, float>> a, b;
+    for (const Disc& d : input) a.push_back(key(d));
+    for (const Disc& d : t.elems) b.push_back(key(d));
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    EXPECT_LE(t.bytesPerPoint(), 40.0);
+}
+
+TEST(LoDTree, CoarseQualityAnswersWithRepresentatives) {
+    PointScene scene;
+    scene.build(randomDiscs(4000, 41));
+    const PinholeCamera cam(fitCamera(scene.bounds(), 45.0f, 1.0f), 32, 32);
+    scene.setLoD(cam.cone(), 8.0f);
+    RayPacket<64> rays;
+    Mask<64> active(true);
+    int repHits = 0;
+    for (int y = 0; y < 32; y += 8)
+        for (int x = 0; x < 32; x += 8) {
+            Packet<64> px, py;
+            for (int i = 0; i < 64; ++i) px[i] = float(x + i % 8) + 0.5f, py[i] = float(y + i / 8) + 0.5f;
+            cam.generate<64>(px, py, rays);
+            const auto hit = scene.intersect<64>(rays, active);
+            for (int i = 0; i < 64; ++i) repHits += hit.id[i] <= -2;
+        }
+    EXPECT_GT(repHits, 0);
+}
+
+TEST(NormalEstimation, PlaneWithinOneDegree) {
+    std::mt19937 g(5);
+    std::uniform_real_distribution<float> u(-1, 1);
+    std::vector<Vec3f> pts;
+    const Vec3f n = normalize(Vec3f(-0.3f, -0.2f, 1.0f));  // plane z = 0.3x + 0.2y
+    for (int i = 0; i < 4000; ++i) {
+        const float x = u(g), y = u(g);
+        pts.push_back({x, y, 0.3f * x + 0.2f * y});
+    }
+    const Vec3f vp(0, 0, 5);
+    const auto normals = estimateNormals(pts, 16, vp, 2);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        EXPECT_GT(dot(normals[i], n), std::cos(1.0f * 3.14159265f / 180.0f)) << i;
+        EXPECT_GE(dot(normals[i], vp - pts[i]), 0.0f);
+    }
+}
+
+TEST(NormalEstimation, SphereWithinThreeDegrees) {
+    std::mt19937 g(6);
+    std::vector<Vec3f> pts;
+    for (int i = 0; i < 20000; ++i) pts.push_back(randomUnit(g));
+    const Vec3f vp(0, 0, 0);  // inside: every normal must face the centre
+    const auto normals = estimateNormals(pts, 16, vp, 2);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        EXPECT_GT(std::fabs(dot(normals[i], pts[i])), std::cos(3.0f * 3.14159265f / 180.0f)) << i;
+        EXPECT_LT(dot(normals[i], pts[i]), 0.0f);
+    }
+}
+
+TEST(Spacing, GridSpacingIsFound) {
+    std::vector<Vec3f> pts;
+    for (int y = 0; y < 50; ++y)
+        for (int x = 0; x < 50; ++x) pts.push_back({float(x) * 0.1f, float(y) * 0.1f, 0.0f});
+    const auto s = neighbourSpacing(pts, 4);
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const int x = int(i % 50), y = int(i / 50);
+        if (x > 0 && x < 49 && y > 0 && y < 49) {
+            EXPECT_NEAR(s[i], 0.1f, 1e-4f);
+        }
+    }
+}
