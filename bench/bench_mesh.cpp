@@ -327,12 +327,15 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
         worstShadow = std::min(worstShadow, rs.mrays() / esBest.mrays());
     }
     // Agreement of the two tracers (a sanity check, not a timing).
-    size_t hitDiff = 0, litDiff = 0;
+    size_t hitDiff = 0, rtOnlyShadow = 0, emOnlyShadow = 0;
     for (size_t i = 0; i < fr.t.size(); ++i) {
         hitDiff += (fr.t[i] < kInfinity) != (fe.t[i] < kInfinity);
-        litDiff += fr.lit[i] != fe.lit[i];
+        if (base.t[i] == kInfinity) continue;
+        rtOnlyShadow += !fr.lit[i] && fe.lit[i];
+        emOnlyShadow += fr.lit[i] && !fe.lit[i];
     }
-    std::printf("agreement: primary_hit_diff_pixels=%zu shadow_diff_pixels=%zu\n", hitDiff, litDiff);
+    std::printf("agreement: primary_hit_diff_pixels=%zu shadowed_only_by_rtfact=%zu shadowed_only_by_embree=%zu\n", hitDiff,
+                rtOnlyShadow, emOnlyShadow);
     const int last = int(threadCounts.size()) - 1;
     std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\nratio_build=%.3f\n", worstPrimary, worstShadow,
                 rtBuild[last] / emBuild[last]);

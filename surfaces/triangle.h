@@ -8,7 +8,7 @@
 // two triangles: no cracks. Vertices, where the spoke values of a whole fan are
 // rounding noise, are closed by a tiny relative tolerance. With a common origin (primary rays, shadow rays cast from
 // a light) the edge vectors are scalar per triangle and each chunk only needs four dot
-// products.
+// products (three edges and the plane).
 #pragma once
 #include "core/concepts/intersector.h"
 
@@ -49,22 +49,23 @@ struct TriangleIntersector {
         using PI = Packet<W, int32_t>;
         const Vec3f n = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
         const P zero(0.0f);
-        // Lanes hit when the three edge functions agree in sign and t is in range.
-        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const P& tnum) __attribute__((always_inline)) {
-            const P den = e0 + e1 + e2;
+        // Lanes hit when the three edge functions agree in sign and t is in range. The
+        // distance comes from the plane equation (tnum / dot(n, d)), not from the edge
+        // sum: edge functions of a small triangle far from the origin lose many bits.
+        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const P& tnum, const P& nd) __attribute__((always_inline)) {
             // A tolerance of 2^-16 of the edge magnitudes closes vertices, where several
             // near-zero spoke values of one fan may all round to the same side.
             const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
-            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (den != zero);
+            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != zero);
             if (none(inside)) return;
-            const P inv = P(1.0f) / den;
-            const P t = tnum * inv;
+            const P t = tnum / nd;
             P& th = hit.t.chunk(k);
             const auto m = inside & (t > rays.tMin.chunk(k)) & (t < th);
             if (none(m)) return;
             th = select(m, t, th);
             hit.id.chunk(k) = select(m, PI(int32_t(id)), hit.id.chunk(k));
             if constexpr (D == HitData::Shading) {
+                const P inv = P(1.0f) / (e0 + e1 + e2);
                 hit.u.chunk(k) = select(m, e1 * inv, hit.u.chunk(k));
                 hit.v.chunk(k) = select(m, e2 * inv, hit.v.chunk(k));
             }
@@ -72,20 +73,19 @@ struct TriangleIntersector {
         if (rays.commonOrigin) {
             const Vec3f o(rays.org.x[0], rays.org.y[0], rays.org.z[0]);
             const Vec3f a = tri.v0 - o, b = tri.v1 - o, c = tri.v2 - o;
-            const Vec3<W> e0(triangleEdge(b, c)), e1(triangleEdge(c, a)), e2(triangleEdge(a, b));
-            // den = e0 + e1 + e2 = -2 dot(n, d), so t = dot(n, a) / dot(n, d) = -2 dot(n, a) / den.
-            const P tnum(-2.0f * dot(n, a));
+            const Vec3<W> e0(triangleEdge(b, c)), e1(triangleEdge(c, a)), e2(triangleEdge(a, b)), nn(n);
+            const P tnum(dot(n, a));
             for (int k = firstChunk; k < Packet<N>::C; ++k) {
                 const Vec3<W> d = rays.dir.chunk(k);
-                finish(k, dot(e0, d), dot(e1, d), dot(e2, d), tnum);
+                finish(k, dot(e0, d), dot(e1, d), dot(e2, d), tnum, dot(nn, d));
             }
         } else {
             const Vec3<W> v0(tri.v0), v1(tri.v1), v2(tri.v2), nn(n);
             for (int k = firstChunk; k < Packet<N>::C; ++k) {
                 const Vec3<W> o = rays.org.chunk(k), d = rays.dir.chunk(k);
                 const Vec3<W> a = v0 - o, b = v1 - o, c = v2 - o;
-                finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d),
-                       P(-2.0f) * dot(nn, a));
+                finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d), dot(nn, a),
+                       dot(nn, d));
             }
         }
     }

@@ -1,0 +1,215 @@
+// Binned SAH BVH builder on primitive references that are partitioned in place (no
+// indirection through an order array while building), with the bounds and centroid
+// bounds of both halves gathered during the partition pass, so every level costs one
+// binning and one partition sweep over contiguous memory. Subtrees are built in
+// parallel with TBB. Works on bounds only, like every builder.
+#pragma once
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <immintrin.h>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include "core/accel/bvh.h"
+#include "core/simd/native.h"
+
+namespace rtfact {
+
+struct InPlaceSAHBVHBuilder {
+    int maxLeafSize = 4;  // larger ranges are always split
+    float traversalCost = 1.0f;
+    float intersectionCost = 1.0f;
+    static constexpr int kBins = 16;
+    static constexpr int kMaxDepth = 64;
+    static constexpr uint32_t kParallelThreshold = 2048;
+
+   private:
+    // Reference layout: two 16-byte halves so bounds update with one SSE min/max each;
+    // the id rides in the unused fourth lane of lo.
+    struct alignas(16) Ref {
+        float lo[4];
+        float hi[4];
+    };
+    struct Box4 {
+        __m128 lo = _mm_set1_ps(kInfinityF), hi = _mm_set1_ps(-kInfinityF);
+        RTFACT_INLINE void extend(__m128 l, __m128 h) {
+            lo = _mm_min_ps(lo, l);
+            hi = _mm_max_ps(hi, h);
+        }
+        RTFACT_INLINE void extend(const Box4& b) { extend(b.lo, b.hi); }
+        float area() const {
+            alignas(16) float l[4], h[4];
+            _mm_store_ps(l, lo);
+            _mm_store_ps(h, hi);
+            const float dx = h[0] - l[0], dy = h[1] - l[1], dz = h[2] - l[2];
+            return dx < 0.0f ? 0.0f : 2.0f * (dx * dy + dy * dz + dz * dx);
+        }
+        AABB aabb() const {
+            alignas(16) float l[4], h[4];
+            _mm_store_ps(l, lo);
+            _mm_store_ps(h, hi);
+            return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+        }
+    };
+    struct Ctx {
+        Ref* refs;
+        BVHNode* nodes;
+        std::atomic<uint32_t>& next;
+    };
+    static RTFACT_INLINE __m128 lo4(const Ref& r) { return _mm_load_ps(r.lo); }
+    static RTFACT_INLINE __m128 hi4(const Ref& r) { return _mm_load_ps(r.hi); }
+    static RTFACT_INLINE __m128 c2(const Ref& r) { return _mm_add_ps(lo4(r), hi4(r)); }  // twice the centroid
+
+   public:
+    void build(std::span<const AABB> bounds, BVHTopology& out) const {
+        const uint32_t n = uint32_t(bounds.size());
+        out.nodes.clear();
+        out.order.resize(n);
+        if (n == 0) return;
+        std::vector<Ref> refs(n);
+        Box4 box, cbox;
+        for (uint32_t i = 0; i < n; ++i) {
+            Ref& r = refs[i];
+            r = {{bounds[i].lo.x, bounds[i].lo.y, bounds[i].lo.z, 0.0f}, {bounds[i].hi.x, bounds[i].hi.y, bounds[i].hi.z, 0.0f}};
+            std::memcpy(&r.lo[3], &i, 4);
+            box.extend(lo4(r), hi4(r));
+            const __m128 c = c2(r);
+            cbox.extend(c, c);
+        }
+        out.nodes.resize(2 * size_t(n));
+        std::atomic<uint32_t> next{1};
+        Ctx ctx{refs.data(), out.nodes.data(), next};
+        buildNode(ctx, 0, 0, n, box, cbox, 0);
+        out.nodes.resize(next.load());
+        for (uint32_t i = 0; i < n; ++i) std::memcpy(&out.order[i], &refs[i].lo[3], 4);
+        reorderDepthFirst(out.nodes);
+    }
+
+   private:
+    void makeLeaf(Ctx& ctx, uint32_t ni, uint32_t b, uint32_t e, const Box4& box) const {
+        const AABB a = box.aabb();
+        ctx.nodes[ni] = {a.lo, int32_t(b), a.hi, int32_t(e - b)};
+    }
+
+    void buildNode(Ctx& ctx, uint32_t ni, uint32_t b, uint32_t e, const Box4& box, const Box4& cbox, int depth) const {
+        const uint32_t n = e - b;
+        if (n <= 1 || depth >= kMaxDepth) return makeLeaf(ctx, ni, b, e, box);
+        const AABB cb = cbox.aabb();
+        const Vec3f ext = cb.extent();
+        int axis = -1, split = 0;
+        float bestCost = kInfinityF;
+        alignas(16) float scale[4] = {0, 0, 0, 0};
+        const __m128 cmin = _mm_setr_ps(cb.lo.x, cb.lo.y, cb.lo.z, 0.0f);
+        if (maxComponent(ext) > 0.0f) {
+            for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
+            const __m128 sc = _mm_load_ps(scale);
+            const __m128i maxBin = _mm_set1_epi32(kBins - 1);
+            Box4 bins[3][kBins];
+            uint32_t counts[3][kBins] = {};
+            for (uint32_t i = b; i < e; ++i) {
+                const Ref& r = ctx.refs[i];
+                const __m128 l = lo4(r), h = hi4(r);
+                const __m128i k = _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_add_ps(l, h), cmin), sc)), maxBin);
+                alignas(16) int32_t ki[4];
+                _mm_store_si128(reinterpret_cast<__m128i*>(ki), k);
+                for (int a = 0; a < 3; ++a) {
+                    counts[a][ki[a]]++;
+                    bins[a][ki[a]].extend(l, h);
+                }
+            }
+            // Sweep: right-to-left areas, then left-to-right costs.
+            for (int a = 0; a < 3; ++a) {
+                if (ext[a] <= 0.0f) continue;
+                float rightArea[kBins];
+                uint32_t rightCount[kBins];
+                Box4 acc;
+                uint32_t cnt = 0;
+                for (int k = kBins - 1; k > 0; --k) {
+                    acc.extend(bins[a][k]);
+                    cnt += counts[a][k];
+                    rightArea[k] = acc.area();
+                    rightCount[k] = cnt;
+                }
+                acc = Box4{};
+                cnt = 0;
+                for (int k = 0; k < kBins - 1; ++k) {
+                    acc.extend(bins[a][k]);
+                    cnt += counts[a][k];
+                    if (cnt == 0 || rightCount[k + 1] == 0) continue;
+                    const float cost = acc.area() * float(cnt) + rightArea[k + 1] * float(rightCount[k + 1]);
+                    if (cost < bestCost) {
+                        bestCost = cost;
+                        axis = a;
+                        split = k;
+                    }
+                }
+            }
+        }
+        const float area = std::max(box.area(), 1e-30f);
+        const float splitCost = traversalCost + intersectionCost * bestCost / area;
+        if (n <= uint32_t(maxLeafSize) && (axis < 0 || splitCost >= intersectionCost * float(n)))
+            return makeLeaf(ctx, ni, b, e, box);
+
+        // Partition in place, gathering both halves' bounds on the way.
+        Box4 lbox, lcbox, rbox, rcbox;
+        uint32_t mid;
+        if (axis >= 0) {
+            const float s = scale[axis], lo = cb.lo[axis];
+            auto left = [&](const Ref& r) { return std::min(int((r.lo[axis] + r.hi[axis] - lo) * s), kBins - 1) <= split; };
+            uint32_t i = b, j = e;
+            while (true) {
+                while (i < j && left(ctx.refs[i])) {
+                    const Ref& r = ctx.refs[i];
+                    lbox.extend(lo4(r), hi4(r));
+                    const __m128 c = c2(r);
+                    lcbox.extend(c, c);
+                    ++i;
+                }
+                while (i < j && !left(ctx.refs[j - 1])) {
+                    --j;
+                    const Ref& r = ctx.refs[j];
+                    rbox.extend(lo4(r), hi4(r));
+                    const __m128 c = c2(r);
+                    rcbox.extend(c, c);
+                }
+                if (i >= j) break;
+                std::swap(ctx.refs[i], ctx.refs[j - 1]);
+            }
+            mid = i;
+        } else {
+            // All centroids coincide: split the range in the middle.
+            mid = b + n / 2;
+            for (uint32_t i = b; i < e; ++i) {
+                const Ref& r = ctx.refs[i];
+                const __m128 c = c2(r);
+                if (i < mid) {
+                    lbox.extend(lo4(r), hi4(r));
+                    lcbox.extend(c, c);
+                } else {
+                    rbox.extend(lo4(r), hi4(r));
+                    rcbox.extend(c, c);
+                }
+            }
+        }
+        const uint32_t left = ctx.next.fetch_add(2);
+        const AABB a = box.aabb();
+        ctx.nodes[ni] = {a.lo, int32_t(left), a.hi, -(axis >= 0 ? axis : 0)};
+        auto buildLeft = [&] { buildNode(ctx, left, b, mid, lbox, lcbox, depth + 1); };
+        auto buildRight = [&] { buildNode(ctx, left + 1, mid, e, rbox, rcbox, depth + 1); };
+        if (n >= kParallelThreshold) tbb::parallel_invoke(buildLeft, buildRight);
+        else {
+            buildLeft();
+            buildRight();
+        }
+    }
+
+    static constexpr float kInfinityF = std::numeric_limits<float>::infinity();
+};
+static_assert(Builder<InPlaceSAHBVHBuilder, BVHTopology>);
+
+}  // namespace rtfact
