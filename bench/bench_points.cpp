@@ -207,7 +207,8 @@ double psnr8(const Frame& a, const Frame& b) {
 
 template <int N>
 int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& cam, int w, int h, int all, int repeat,
-        float quality, int leafSize, double loadMs) {
+        std::vector<float> qualities, int leafSize, double loadMs) {
+    const float quality = qualities.front();
     const size_t n = discs.size();
     std::printf("file=%s\npoints=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nload_ms=%.1f\n", file.c_str(), n,
                 w, h, N, all, quality, loadMs);
@@ -266,6 +267,14 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
     for (size_t i = 0; i < ff.hit.size(); ++i) hitDiff += ff.hit[i] != fe.hit[i];
     std::printf("agreement_full_vs_embree: hit_diff_pixels=%zu psnr=%.2f\n", hitDiff, psnr8(ff, fe));
     std::printf("psnr_lod_vs_full=%.2f\n", psnr8(fl, ff));
+    // Further qualities: all threads only.
+    for (size_t qi = 1; qi < qualities.size(); ++qi) {
+        const float q = qualities[qi];
+        double lod = 1e30;
+        scene.setLoD(cam.cone(), q);
+        for (int r = 0; r < repeat; ++r) lod = std::min(lod, timeTiles(all, w, h, [&](int x, int y) { rt.tile(fl, x, y); }));
+        std::printf("quality=%.3g threads=%d lod_frame_ms=%.1f lod_mrays=%.2f psnr_lod_vs_full=%.2f\n", q, all, lod, mr(lod), psnr8(fl, ff));
+    }
     std::printf("ratio_full=%.3f\nratio_lod=%.3f\n", worstFull, worstLod);
     std::printf("(ratios: Embree frame time / RTfact frame time, the worse of 1 and %d threads)\n", all);
     return 0;
@@ -276,7 +285,8 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
 int benchPoints(int argc, char** argv) {
     CLI::App app{"RTfact LoD kd-tree discs vs Embree oriented-disc points", "rtfact-bench points"};
     std::string file, eye, at, up, size = "1024x1024", normals = "auto";
-    float fov = 45.0f, quality = 1.0f, radius = 0.0f, radiusFactor = 1.0f;
+    float fov = 45.0f, radius = 0.0f, radiusFactor = 1.0f;
+    std::vector<float> quality{1.0f};
     int threads = 0, packet = 64, repeat = 3, leafSize = 8;
     app.add_option("FILE", file, "Point cloud (.ply .pcd .xyz .pts)")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
@@ -287,7 +297,9 @@ int benchPoints(int argc, char** argv) {
     app.add_option("--size", size, "Image size WxH")->capture_default_str();
     app.add_option("--packet", packet, "RTfact packet size: 1, 16, 64 or 256")->capture_default_str()->check(CLI::IsMember({1, 16, 64, 256}));
     app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")->capture_default_str()->check(CLI::Range(1, 100));
-    app.add_option("--lod-quality", quality, "LoD quality for the LoD run")->capture_default_str()->check(CLI::Range(0.0f, 64.0f));
+    app.add_option("--lod-quality", quality, "LoD quality for the LoD run (more values: extra LoD runs at all threads)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0f, 64.0f));
     app.add_option("--leaf-size", leafSize, "Maximum points per leaf")->capture_default_str()->check(CLI::Range(1, 64));
     app.add_option("--radius", radius, "Disc radius for every point");
     app.add_option("--radius-factor", radiusFactor, "Scale of the radii")->capture_default_str();

@@ -13,14 +13,24 @@
 
 namespace rtfact::points {
 
-// What an inner node adds to its 8-byte KdNode: its representative disc and the extent
-// of its children along the split axis. Stored at the node's inner ordinal
-// (left child - 1) / 2, so leaves pay nothing.
+// What an inner node adds to its 8-byte KdNode: its representative disc and the bounds
+// of its two children, quantised to 8 bits per coordinate inside the representative's
+// covering sphere box (rounded outwards). The traversal clips the children's cells to
+// these boxes, which both tightens them and lets discs reach across split planes.
+// Stored at the node's inner ordinal (left child - 1) / 2, so leaves pay nothing.
 struct LoDInner {
     Disc rep;
-    float leftHi, rightLo;
+    uint8_t childBox[2][6];  // lo.xyz, hi.xyz per child, in 1/255 of the sphere box
+
+    AABB box(int child) const {
+        const float step = rep.radius * (2.0f / 255.0f);
+        const Vec3f base = rep.center - Vec3f(rep.radius);
+        const uint8_t* q = childBox[child];
+        return {base + Vec3f(float(q[0]), float(q[1]), float(q[2])) * step,
+                base + Vec3f(float(q[3]), float(q[4]), float(q[5])) * step};
+    }
 };
-static_assert(sizeof(LoDInner) == 32);
+static_assert(sizeof(LoDInner) == 36);
 
 struct LoDKdTree : KdTree<Disc> {
     std::vector<LoDInner> inner;

@@ -54,6 +54,18 @@ Disc makeRep(const Agg& a, float radius) {
     return r;
 }
 
+// Outward rounding with one step of margin: the decoder may round differently (FMA).
+void quantiseChildBox(LoDInner& in, int child, const AABB& b) {
+    const float step = in.rep.radius * (2.0f / 255.0f);
+    const Vec3f base = in.rep.center - Vec3f(in.rep.radius);
+    for (int a = 0; a < 3; ++a) {
+        const float lo = std::floor((b.lo[a] - base[a]) / step) - 1.0f;
+        const float hi = std::ceil((b.hi[a] - base[a]) / step) + 1.0f;
+        in.childBox[child][a] = uint8_t(std::clamp(lo, 0.0f, 255.0f));
+        in.childBox[child][3 + a] = uint8_t(std::clamp(hi, 0.0f, 255.0f));
+    }
+}
+
 Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t next) {
     LoDKdTree& t = *ctx.tree;
     Agg a;
@@ -74,7 +86,7 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         Disc rep = makeRep(a, 0.0f);
         float r = 0;
         for (size_t i = 0; i < n; ++i) r = std::max(r, length(d[i].center - rep.center) + d[i].radius);
-        rep.radius = r * 1.0001f + 1e-7f;
+        rep.radius = r * 1.002f + 1e-7f;  // margin covers the padding of Disc::bounds()
         a.rep = rep;
         return a;
     }
@@ -97,10 +109,6 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         br();
     }
     LoDInner& in = t.inner[(left - 1) / 2];
-    // Padded: disc bounds may round differently where the compiler contracts to FMA.
-    const float pad = 1e-6f * (std::fabs(la.box.hi[axis]) + std::fabs(ra.box.lo[axis]) + cell.hi[axis] - cell.lo[axis]);
-    in.leftHi = la.box.hi[axis] + pad;
-    in.rightLo = ra.box.lo[axis] - pad;
     a.w = la.w + ra.w;
     for (int k = 0; k < 3; ++k) {
         a.c[k] = la.c[k] + ra.c[k];
@@ -112,8 +120,10 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
     Disc rep = makeRep(a, 0.0f);
     const Disc &lr = la.rep, &rr = ra.rep;
     const float r = std::max(length(lr.center - rep.center) + lr.radius, length(rr.center - rep.center) + rr.radius);
-    rep.radius = r * 1.0001f + 1e-7f;
+    rep.radius = r * 1.002f + 1e-7f;  // margin covers the padding of Disc::bounds()
     in.rep = rep;
+    quantiseChildBox(in, 0, la.box);
+    quantiseChildBox(in, 1, ra.box);
     a.rep = rep;
     return a;
 }

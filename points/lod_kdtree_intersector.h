@@ -1,5 +1,6 @@
 // LoDKdTreeIntersector<ElemIsect>: the core's generic kd-tree traversal with two hooks:
-// children's cells clipped to their real extent (discs reach across split planes), and
+// children's cells clipped to their stored (quantised) bounds, which also covers discs
+// reaching across split planes, and
 // level-of-detail cuts: when a node's representative disc is smaller than the ray
 // footprint at its distance times `quality`, the packet intersects that disc instead of
 // descending. The footprint is the camera's cone, width(t) = base + slope * t, measured
@@ -47,13 +48,9 @@ struct LoDNodeIntersector {
 
     template <class Tree>
     RTFACT_INLINE void childCells(const Tree& tree, uint32_t node, const AABB& cell, AABB& lo, AABB& hi) const {
-        const KdNode& nd = tree.nodes[node];
-        const int axis = nd.axis();
-        const LoDInner& in = inner[LoDKdTree::innerIndex(nd)];
-        lo = cell;
-        hi = cell;
-        lo.hi[axis] = std::min(cell.hi[axis], in.leftHi);
-        hi.lo[axis] = std::max(cell.lo[axis], in.rightLo);
+        const LoDInner& in = inner[LoDKdTree::innerIndex(tree.nodes[node])];
+        lo = intersection(cell, in.box(0));
+        hi = intersection(cell, in.box(1));
     }
 };
 

@@ -195,9 +195,9 @@ TEST(LoDTree, RepresentativeDiscsCoverTheirSubtrees) {
         const Range a = walk(n.left()), b = walk(n.left() + 1);
         EXPECT_EQ(a.first + a.count, b.first);  // subtrees are contiguous in leaf order
         const LoDInner& in = t.inner[LoDKdTree::innerIndex(n)];
-        const int axis = n.axis();
-        for (uint32_t i = a.first; i < a.first + a.count; ++i) EXPECT_LE(t.elems[i].bounds().hi[axis], in.leftHi);
-        for (uint32_t i = b.first; i < b.first + b.count; ++i) EXPECT_GE(t.elems[i].bounds().lo[axis], in.rightLo);
+        // The quantised child boxes contain their discs.
+        for (uint32_t i = a.first; i < a.first + a.count; ++i) EXPECT_TRUE(in.box(0).contains(t.elems[i].bounds())) << node;
+        for (uint32_t i = b.first; i < b.first + b.count; ++i) EXPECT_TRUE(in.box(1).contains(t.elems[i].bounds())) << node;
         const Disc& rep = in.rep;
         for (uint32_t i = a.first; i < b.first + b.count; ++i) {
             const Disc& d = t.elems[i];
