@@ -350,7 +350,7 @@ int benchMesh(int argc, char** argv) {
     CLI::App app{"RTfact vs Embree on a mesh: BVH build, primary and shadow rays", "rtfact-bench mesh"};
     std::string file, eye, at, up, size = "1024x1024";
     float fov = 45.0f;
-    int threads = 0, packet = 256, repeat = 3;
+    int threads = 0, packet = 256, repeat = 3, grid = 1;
     app.add_option("FILE", file, "Mesh file")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
     app.add_option("--at", at, "Camera target x,y,z");
@@ -359,6 +359,9 @@ int benchMesh(int argc, char** argv) {
     app.add_option("--threads", threads, "All-threads figure uses this many (0: all cores)")->capture_default_str();
     app.add_option("--size", size, "Image size WxH")->capture_default_str();
     app.add_option("--packet", packet, "RTfact packet size: 16, 64 or 256")->capture_default_str()->check(CLI::IsMember({16, 64, 256}));
+    app.add_option("--grid", grid, "Many occluders: a GxG grid of copies of the mesh on a ground plane")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
     app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")->capture_default_str()->check(CLI::Range(1, 100));
     try {
         app.parse(argc, argv);
@@ -368,7 +371,27 @@ int benchMesh(int argc, char** argv) {
     int w = 1024, h = 1024;
     if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 16384 || h > 16384 || w % 16 || h % 16)
         throw Error("", "--size: expected WxH, multiples of 16 in 16..16384");
-    const Mesh mesh = loadMesh(file);
+    Mesh mesh = loadMesh(file);
+    if (grid > 1) {
+        // Copies side by side (shadowing each other) on a ground quad.
+        const Mesh one = mesh;
+        const AABB b = one.bounds();
+        const Vec3f e = b.extent();
+        const float step = 1.05f * std::max(e.x, e.z);
+        for (int gz = 0; gz < grid; ++gz)
+            for (int gx = 0; gx < grid; ++gx) {
+                if (gx == 0 && gz == 0) continue;
+                Mesh c = one;
+                for (Vec3f& p : c.positions) p += Vec3f(float(gx) * step, 0.0f, float(gz) * step);
+                mesh.append(c);
+            }
+        Mesh ground;
+        const float lo = -step, hi = float(grid) * step;
+        ground.positions = {{lo, b.lo.y, lo}, {hi, b.lo.y, lo}, {hi, b.lo.y, hi}, {lo, b.lo.y, hi}};
+        ground.indices = {0, 2, 1, 0, 3, 2};
+        ground.computeNormals();
+        mesh.append(ground);
+    }
     Setup setup;
     const AABB box = mesh.bounds();
     CameraFrame frame = fitCamera(box, fov, float(w) / float(h));

@@ -7,6 +7,9 @@
 #include <type_traits>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "core/accel/bvh_intersector.h"
 #include "core/accel/in_place_sah_bvh_builder.h"
 #include "core/accel/kdtree_intersector.h"
@@ -14,6 +17,7 @@
 #include "core/accel/sah_kdtree_builder.h"
 #include "core/concepts/scene.h"
 #include "core/render/tracer.h"
+#include "core/util/huge_pages.h"
 #include "surfaces/mesh.h"
 #include "surfaces/triangle.h"
 
@@ -63,11 +67,33 @@ struct MeshScene {
     explicit MeshScene(std::shared_ptr<const Mesh> m) : mesh(std::move(m)) { build(); }
 
     void build() {
-        const std::vector<Triangle> tris = meshTriangles(*mesh);
-        if constexpr (std::is_same_v<Structure, BVH<Triangle>>)
-            accel = buildBVH<Triangle>(meshBVHBuilder(), std::span<const Triangle>(tris));
-        else
+        if constexpr (std::is_same_v<Structure, BVH<Triangle>>) {
+            // Straight from the indexed mesh into leaf order, on huge pages (no
+            // intermediate triangle array: first-touch page faults dominate big builds).
+            const Mesh& m = *mesh;
+            const size_t n = m.triangles();
+            std::vector<AABB> bounds;
+            resizeHugePages(bounds, n);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t i = r.begin(); i != r.end(); ++i) {
+                    AABB b;
+                    b.extend(m.positions[m.indices[3 * i]]).extend(m.positions[m.indices[3 * i + 1]]).extend(m.positions[m.indices[3 * i + 2]]);
+                    bounds[i] = b;
+                }
+            });
+            accel = BVH<Triangle>{};
+            meshBVHBuilder().build(std::span<const AABB>(bounds), static_cast<BVHTopology&>(accel));
+            resizeHugePages(accel.elems, n);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t i = r.begin(); i != r.end(); ++i) {
+                    const uint32_t t = accel.order[i];
+                    accel.elems[i] = {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
+                }
+            });
+        } else {
+            const std::vector<Triangle> tris = meshTriangles(*mesh);
             accel = buildKdTree<Triangle>(SAHKdTreeBuilder{}, std::span<const Triangle>(tris));
+        }
         box = mesh->bounds();
         materialColor.clear();
         for (const MeshMaterial& mm : mesh->materials) materialColor.push_back(mm.kd);

@@ -17,6 +17,7 @@
 
 #include "core/accel/bvh.h"
 #include "core/simd/native.h"
+#include "core/util/huge_pages.h"
 
 namespace rtfact {
 
@@ -69,9 +70,12 @@ struct InPlaceSAHBVHBuilder {
     void build(std::span<const AABB> bounds, BVHTopology& out) const {
         const uint32_t n = uint32_t(bounds.size());
         out.nodes.clear();
-        out.order.resize(n);
-        if (n == 0) return;
-        std::vector<Ref> refs(n);
+        if (n == 0) {
+            out.order.clear();
+            return;
+        }
+        std::vector<Ref> refs;
+        resizeHugePages(refs, n);
         Box4 box, cbox;
         for (uint32_t i = 0; i < n; ++i) {
             Ref& r = refs[i];
@@ -81,13 +85,31 @@ struct InPlaceSAHBVHBuilder {
             const __m128 c = c2(r);
             cbox.extend(c, c);
         }
-        out.nodes.resize(2 * size_t(n));
+        std::vector<BVHNode> nodes;
+        resizeHugePages(nodes, 2 * size_t(n));
         std::atomic<uint32_t> next{1};
-        Ctx ctx{refs.data(), out.nodes.data(), next};
+        Ctx ctx{refs.data(), nodes.data(), next};
         buildNode(ctx, 0, 0, n, box, cbox, 0);
-        out.nodes.resize(next.load());
+        out.order.clear();
+        resizeHugePages(out.order, n);
         for (uint32_t i = 0; i < n; ++i) std::memcpy(&out.order[i], &refs[i].lo[3], 4);
-        reorderDepthFirst(out.nodes);
+        // Depth-first order (left child right after its parent's pair) for locality.
+        resizeHugePages(out.nodes, next.load());
+        out.nodes[0] = nodes[0];
+        uint32_t used = 1;
+        std::vector<std::pair<uint32_t, uint32_t>> stack;  // (new index, old left child)
+        if (!nodes[0].isLeaf()) stack.push_back({0u, uint32_t(nodes[0].ofs)});
+        while (!stack.empty()) {
+            const auto [parent, oldLeft] = stack.back();
+            stack.pop_back();
+            const uint32_t newLeft = used;
+            used += 2;
+            out.nodes[parent].ofs = int32_t(newLeft);
+            out.nodes[newLeft] = nodes[oldLeft];
+            out.nodes[newLeft + 1] = nodes[oldLeft + 1];
+            if (!nodes[oldLeft + 1].isLeaf()) stack.push_back({newLeft + 1, uint32_t(nodes[oldLeft + 1].ofs)});
+            if (!nodes[oldLeft].isLeaf()) stack.push_back({newLeft, uint32_t(nodes[oldLeft].ofs)});
+        }
     }
 
    private:
