@@ -29,7 +29,6 @@
 #include "core/render/ray_tracing_renderer.h"
 #include "core/render/tile_scheduler.h"
 #include "core/util/error.h"
-#include "volume/macrocell_grid.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
@@ -149,32 +148,37 @@ int benchVolume(int argc, char** argv) {
     if (!dims.empty()) lo.dims = parseDims(dims);
     lo.type = type;
     lo.progress = false;
+    const bool isVdb = dims.empty() && file.size() > 4 && file.substr(file.size() - 4) == ".vdb";
     auto t0 = Clock::now();
-    VolumeGrid g = loadVolume(file, lo);
+    VolumeGrid g;
+    BrickedVolume vol;
+    if (isVdb) vol = loadVDBBricked(file, lo);  // sparse: never densified
+    else g = loadVolume(file, lo);
     const double loadMs = msSince(t0);
-    if (std::fabs(g.spacing.x - g.spacing.y) > 1e-6f || std::fabs(g.spacing.x - g.spacing.z) > 1e-6f) {
-        std::printf("note: anisotropic spacing; both renderers use isotropic spacing %g here (OpenVDB's intersector needs uniform voxels)\n",
-                    double(minComponent(g.spacing)));
-        g.spacing = Vec3f(minComponent(g.spacing));
-    }
     t0 = Clock::now();
-    const MacrocellGrid mc = buildMacrocells(g);
-    const VolumeSummary sum = summarize(g, 4);
+    if (!isVdb) vol = brickVolume(g);
+    if (std::fabs(vol.spacing.x - vol.spacing.y) > 1e-6f || std::fabs(vol.spacing.x - vol.spacing.z) > 1e-6f) {
+        std::printf("note: anisotropic spacing; both renderers use isotropic spacing %g here (OpenVDB's intersector needs uniform voxels)\n",
+                    double(minComponent(vol.spacing)));
+        vol.spacing = g.spacing = Vec3f(minComponent(vol.spacing));
+    }
+    const auto range = vol.valueRange();
     const TransferFunction tf = resolveTransferFunction(tfName);
-    const auto win = resolveWindow(tf, sum.lo, sum.hi, window, level);
+    const auto win = resolveWindow(tf, range.first, range.second, window, level);
     const TFTable table = buildTable(tf, win, step);
     VolumeRenderSettings rs;
     rs.stepVoxels = step;
     const double buildMs = msSince(t0);
-    const AABB box = g.bounds();
+    const AABB box = vol.bounds();
     CameraFrame frame = fitCamera(box, fov, float(w) / float(h), {0.45f, -1.0f, 0.35f}, {0, 0, 1});
     if (!eye.empty()) frame.eye = parseV(eye, "--eye");
     if (!at.empty()) frame.at = parseV(at, "--at");
     if (!up.empty()) frame.up = parseV(up, "--up");
     const PinholeCamera cam(frame, w, h);
     const int allThreads = resolveThreads(threads);
-    std::printf("volume %s: %dx%dx%d %s (%s), %.1f MB stored, load %.0f ms, macrocells+TF %.0f ms\n", file.c_str(), g.dims[0], g.dims[1],
-                g.dims[2], storageName(g.storage), g.sourceType.c_str(), double(g.memoryBytes()) / 1048576.0, loadMs, buildMs);
+    std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, bricks+TF %.0f ms\n", file.c_str(),
+                vol.dims[0], vol.dims[1], vol.dims[2], storageName(vol.storage), vol.sourceType.c_str(), vol.storedBricks(), vol.brickCount(),
+                double(vol.memoryBytes()) / 1048576.0, loadMs, buildMs);
     std::printf("view %dx%d, tf %s window [%g, %g], step %g voxels, packet %d, frames %d (best reported)\n", w, h, tf.name.c_str(),
                 double(win.first), double(win.second), double(step), packet, frames);
 
@@ -185,7 +189,7 @@ int benchVolume(int argc, char** argv) {
     std::vector<float> ourImage;
     auto runOurs = [&](int th) {
         Result best{1e300, 0};
-        withVolumeScene(g, table, mc, rs, [&](const auto& scene) {
+        withVolumeScene(vol, table, rs, [&](const auto& scene) {
             const RayTracingRenderer<PixelCenterSampler, VolumeIntegrator> renderer{};
             for (int f = 0; f < frames; ++f) {
                 RGBAFramebuffer fb(w, h);
@@ -227,7 +231,6 @@ int benchVolume(int argc, char** argv) {
 
     if (!skipPeer) {
         t0 = Clock::now();
-        const bool isVdb = file.size() > 4 && file.substr(file.size() - 4) == ".vdb";
         if (isVdb) {
             // The file's own sparse tree (values in data units = stored units here).
             openvdb::io::File f(file);
@@ -241,16 +244,16 @@ int benchVolume(int argc, char** argv) {
             peer.grid = denseToVdb(g, table);
         }
         if (!peer.grid) throw Error(file, "no float grid for the OpenVDB peer");
-        openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(double(g.spacing.x));
+        openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(double(vol.spacing.x));
         // Our grid starts at the active bbox minimum; align the VDB index space with ours.
         openvdb::Coord bmin(0, 0, 0);
         if (isVdb) bmin = peer.grid->evalActiveVoxelBoundingBox().min();
-        xf->postTranslate(openvdb::Vec3d(g.origin.x, g.origin.y, g.origin.z) - openvdb::Vec3d(bmin.x(), bmin.y(), bmin.z()) * double(g.spacing.x));
+        xf->postTranslate(openvdb::Vec3d(vol.origin.x, vol.origin.y, vol.origin.z) - openvdb::Vec3d(bmin.x(), bmin.y(), bmin.z()) * double(vol.spacing.x));
         peer.grid->setTransform(xf);
         peer.tf = &table;
         const float k = float(table.size - 1) / (table.hi - table.lo);
-        peer.tfMul = g.scale * k;
-        peer.tfAdd = (g.offset - table.lo) * k + 0.5f;
+        peer.tfMul = vol.scale * k;
+        peer.tfAdd = (vol.offset - table.lo) * k + 0.5f;
         peer.step = step;
         peer.term = rs.earlyTermination;
         std::printf("openvdb grid: %llu active voxels, built in %.0f ms\n", (unsigned long long)peer.grid->activeVoxelCount(), msSince(t0));

@@ -37,19 +37,30 @@ struct VolumeIntegrator {
         return r;
     }
 
+    template <int W>
+    static RTFACT_INLINE Packet<W, int32_t> shr3(const Packet<W, int32_t>& a) {
+        Packet<W, int32_t> r;
+        for (int i = 0; i < Packet<W, int32_t>::C; ++i) r.c[i] = a.c[i] >> 3;
+        return r;
+    }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
     template <int W, class Scene>
     static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p) {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
+        constexpr int E = Scene::kEdge;
         const I ix = toInt(p.x), iy = toInt(p.y), iz = toInt(p.z);
         const P fx = p.x - toFloat(ix), fy = p.y - toFloat(iy), fz = p.z - toFloat(iz);
-        const I base = ix + iy * I(s.strideY) + iz * I(s.strideZ);
+        // brick of the cell, then the cell's first sample inside the brick
+        static_assert(Scene::kCells == 8);
+        const I bx = shr3(ix), by = shr3(iy), bz = shr3(iz);
+        const I start = gather(s.brickStart, bx + by * I(s.nbx) + bz * I(s.nbxy));
+        const I base = start + (ix - bx * I(8)) + (iy - by * I(8)) * I(E) + (iz - bz * I(8)) * I(E * E);
         P a0, b0, a1, b1, a2, b2, a3, b3;
         fetchPair<typename Scene::Voxel, W>(s.voxels, base, a0, b0);
-        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(s.strideY), a1, b1);
-        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(s.strideZ), a2, b2);
-        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(s.strideY + s.strideZ), a3, b3);
+        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(E), a1, b1);
+        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(E * E), a2, b2);
+        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(E * E + E), a3, b3);
         const P c0 = a0 + (b0 - a0) * fx, c1 = a1 + (b1 - a1) * fx, c2 = a2 + (b2 - a2) * fx, c3 = a3 + (b3 - a3) * fx;
         const P d0 = c0 + (c1 - c0) * fy, d1 = c2 + (c3 - c2) * fy;
         return d0 + (d1 - d0) * fz;
@@ -142,7 +153,7 @@ struct VolumeIntegrator {
                 if (any(empty)) {
                     P tExit(kInfinity);
                     for (int a = 0; a < 3; ++a) {
-                        const P bound = toFloat(c[a] + select(di[a] > P(0.0f), I(1), I(0))) * P(float(MacrocellGrid::kCell));
+                        const P bound = toFloat(c[a] + select(di[a] > P(0.0f), I(1), I(0))) * P(float(Scene::kCells));
                         tExit = min(tExit, (bound - oi[a]) * inv[a]);
                     }
                     const P kk = max(-floor(-((tExit - tNear) * invDt - P(0.5f))), kf + P(1.0f));

@@ -704,6 +704,22 @@ VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt) {
     return g;
 }
 
+BrickedVolume loadBrickedVolume(const std::string& path, const VolumeLoadOptions& opt) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw Error(path, "no such file or directory");
+    if (!fs::is_directory(path, ec) && endsWith(lower(path), ".vdb") && !opt.dims) {
+        BrickedVolume v = loadVDBBricked(path, opt);
+        if (opt.spacing) v.spacing = *opt.spacing;
+        return v;
+    }
+    VolumeGrid g = loadVolume(path, opt);
+    try {
+        return brickVolume(g, true);
+    } catch (const Error& e) {
+        throw Error(path, e.what());
+    }
+}
+
 void writeRaw(const std::string& path, const VolumeGrid& g) {
     std::ofstream f(path, std::ios::binary);
     if (!f) throw Error(path, "cannot write file");

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "volume/brick_volume.h"
 #include "volume/volume_grid.h"
 
 namespace rtfact::volume {
@@ -26,6 +27,11 @@ struct VolumeLoadOptions {
 // True for paths this module claims (by extension, or a directory of DICOM files).
 bool looksLikeVolume(const std::string& path);
 VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt = {});
+
+// The render-time layout: OpenVDB grids are bricked straight from their sparse tree
+// (never densified); everything else is loaded dense, bricked and the dense copy freed.
+BrickedVolume loadBrickedVolume(const std::string& path, const VolumeLoadOptions& opt = {});
+BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& opt);
 
 // Parses "X,Y,Z" dims and "sx,sy,sz" spacing; throw rtfact::Error naming `what`.
 std::array<int, 3> parseDims(const std::string& text);

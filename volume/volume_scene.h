@@ -1,13 +1,16 @@
 // VolumeScene<T>: what the volume integrators read, for voxels stored as T (u8, u16,
 // f32): the grid in index space, the clip box, the transfer-function lookup table and
-// the per-mode macrocell occupancy. Built once per frame setup; the grid is referenced.
+// the per-mode brick occupancy. Built once per frame setup; the bricks are referenced.
 #pragma once
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "core/util/error.h"
-#include "volume/macrocell_grid.h"
+#include <algorithm>
+#include <limits>
+
+#include "volume/brick_volume.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_grid.h"
 
@@ -27,9 +30,11 @@ struct VolumeRenderSettings {
 template <class T>
 struct VolumeScene {
     using Voxel = T;
-    const T* voxels = nullptr;
+    static constexpr int kCells = BrickedVolume::kCells, kEdge = BrickedVolume::kEdge;
+    const T* voxels = nullptr;      // brick pool
+    const int32_t* brickStart = nullptr;
     int dims[3] = {0, 0, 0};
-    int32_t strideY = 0, strideZ = 0;
+    int32_t nbx = 0, nbxy = 0;      // brick grid strides
     Vec3f origin, invSpacing, spacing;
     Vec3f boxLo, boxHi;   // index space, after clipping
     Vec3f clampHi;        // largest coordinate trilinear sampling may use per axis
@@ -39,24 +44,25 @@ struct VolumeScene {
     TFTable tf;
     float tfMul = 0, tfAdd = 0;
     float isoStored = 0;
-    // Macrocells: flags (non-zero = may contribute) for DVR/iso, maxima for MIP.
+    // Bricks are the macrocells: flags (non-zero = may contribute) for DVR/iso, maxima for MIP.
     int cells[3] = {0, 0, 0};
     std::vector<int32_t> cellFlags;
     std::vector<float> cellMax;
-    float invCell = 1.0f / MacrocellGrid::kCell;
+    float invCell = 1.0f / kCells;
 
-    VolumeScene(const VolumeGrid& g, const TFTable& table, const MacrocellGrid& mc, const VolumeRenderSettings& s)
-        : settings(s), tf(table) {
+    VolumeScene(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& s) : settings(s), tf(table) {
         for (int a = 0; a < 3; ++a) {
-            if (g.dims[a] < 2) throw Error("", "cannot render a volume with fewer than 2 voxels along an axis");
-            dims[a] = g.dims[a];
+            if (v.dims[a] < 2) throw Error("", "cannot render a volume with fewer than 2 voxels along an axis");
+            dims[a] = v.dims[a];
+            cells[a] = v.nb[a];
         }
-        voxels = g.data<T>();
-        strideY = dims[0];
-        strideZ = dims[0] * dims[1];
-        origin = g.origin;
-        spacing = g.spacing;
-        invSpacing = Vec3f(1.0f / g.spacing.x, 1.0f / g.spacing.y, 1.0f / g.spacing.z);
+        voxels = v.data<T>();
+        brickStart = v.brickStart.data();
+        nbx = v.nb[0];
+        nbxy = v.nb[0] * v.nb[1];
+        origin = v.origin;
+        spacing = v.spacing;
+        invSpacing = Vec3f(1.0f / v.spacing.x, 1.0f / v.spacing.y, 1.0f / v.spacing.z);
         for (int a = 0; a < 3; ++a) {
             const float n1 = float(dims[a] - 1);
             boxLo[a] = std::clamp(s.clipLo[a], 0.0f, 1.0f) * n1;
@@ -64,46 +70,38 @@ struct VolumeScene {
             clampHi[a] = std::nextafter(n1, 0.0f);
         }
         if (!(s.stepVoxels > 0) || !std::isfinite(s.stepVoxels)) throw Error("--step", "step must be positive");
-        dt = s.stepVoxels * minComponent(g.spacing);
+        dt = s.stepVoxels * minComponent(v.spacing);
         // TF entry of a stored value: ((stored * scale + offset) - lo) / (hi - lo) * (size - 1)
         const float k = float(tf.size - 1) / (tf.hi - tf.lo);
-        tfMul = g.scale * k;
-        tfAdd = (g.offset - tf.lo) * k + 0.5f;
-        isoStored = (s.iso - g.offset) / g.scale;
-        for (int a = 0; a < 3; ++a) cells[a] = mc.n[a];
-        cellFlags.resize(mc.count());
-        cellMax = mc.hi;
-        for (size_t i = 0; i < mc.count(); ++i) {
-            const float lo = mc.lo[i] * g.scale + g.offset, hi = mc.hi[i] * g.scale + g.offset;
+        tfMul = v.scale * k;
+        tfAdd = (v.offset - tf.lo) * k + 0.5f;
+        isoStored = (s.iso - v.offset) / v.scale;
+        const size_t nc = v.brickCount();
+        cellFlags.resize(nc);
+        cellMax = v.cellHi;
+        for (size_t i = 0; i < nc; ++i) {
+            const float lo = v.cellLo[i] * v.scale + v.offset, hi = v.cellHi[i] * v.scale + v.offset;
             bool on = true;
             if (s.mode == VolumeMode::DVR || s.mode == VolumeMode::Shaded) on = tf.visible(std::min(lo, hi), std::max(lo, hi));
             else if (s.mode == VolumeMode::Iso) on = std::min(lo, hi) <= s.iso && s.iso <= std::max(lo, hi);
             cellFlags[i] = (on || !s.skipping) ? 1 : 0;
         }
-        if (g.scale < 0) {
-            // MIP on a decreasing map: skip nothing (maxima of stored values mean minima).
-            std::fill(cellMax.begin(), cellMax.end(), std::numeric_limits<float>::infinity());
-        }
-        if (!s.skipping) std::fill(cellMax.begin(), cellMax.end(), std::numeric_limits<float>::infinity());
+        // MIP skips on stored maxima; a decreasing value map (negative scale) or no
+        // skipping: never skip.
+        if (v.scale < 0 || !s.skipping) std::fill(cellMax.begin(), cellMax.end(), std::numeric_limits<float>::infinity());
     }
 
-    AABB bounds() const {
-        return {origin + boxLo * spacing, origin + boxHi * spacing};
-    }
+    AABB bounds() const { return {origin + boxLo * spacing, origin + boxHi * spacing}; }
 };
 
-}  // namespace rtfact::volume
-
-namespace rtfact::volume {
-
-// Calls f(const VolumeScene<T>&) with T the grid's storage type: the one place where the
-// run-time storage type becomes a compile-time one.
+// Calls f(const VolumeScene<T>&) with T the volume's storage type: the one place where
+// the run-time storage type becomes a compile-time one.
 template <class F>
-void withVolumeScene(const VolumeGrid& g, const TFTable& tf, const MacrocellGrid& mc, const VolumeRenderSettings& s, F&& f) {
-    switch (g.storage) {
-        case Storage::U8: f(VolumeScene<uint8_t>(g, tf, mc, s)); break;
-        case Storage::U16: f(VolumeScene<uint16_t>(g, tf, mc, s)); break;
-        default: f(VolumeScene<float>(g, tf, mc, s)); break;
+void withVolumeScene(const BrickedVolume& v, const TFTable& tf, const VolumeRenderSettings& s, F&& f) {
+    switch (v.storage) {
+        case Storage::U8: f(VolumeScene<uint8_t>(v, tf, s)); break;
+        case Storage::U16: f(VolumeScene<uint16_t>(v, tf, s)); break;
+        default: f(VolumeScene<float>(v, tf, s)); break;
     }
 }
 

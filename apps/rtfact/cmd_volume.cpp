@@ -8,7 +8,6 @@
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/render_command.h"
 #include "core/util/error.h"
-#include "volume/macrocell_grid.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
@@ -101,22 +100,33 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                         TransferFunction tf = resolveTransferFunction(o->tf.empty() ? (rs.mode == VolumeMode::MIP ? "grayscale" : "ct-bone") : o->tf);
                         Stats stats;
                         auto t0 = std::chrono::steady_clock::now();
-                        const VolumeGrid grid = loadVolume(o->file, o->load.options(!c.quiet));
-                        stats.add("load_ms", msSince(t0));
-                        t0 = std::chrono::steady_clock::now();
-                        const MacrocellGrid mc = buildMacrocells(grid);
-                        float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-                        for (size_t i = 0; i < mc.count(); ++i) {
-                            lo = std::min(lo, std::min(mc.lo[i] * grid.scale + grid.offset, mc.hi[i] * grid.scale + grid.offset));
-                            hi = std::max(hi, std::max(mc.lo[i] * grid.scale + grid.offset, mc.hi[i] * grid.scale + grid.offset));
+                        const VolumeLoadOptions lopt = o->load.options(!c.quiet);
+                        BrickedVolume vol;
+                        const bool sparse = o->load.dims.empty() && o->file.size() > 4 && o->file.substr(o->file.size() - 4) == ".vdb";
+                        if (sparse) {
+                            // bricked straight from the sparse tree
+                            vol = loadBrickedVolume(o->file, lopt);
+                            stats.add("load_ms", msSince(t0));
+                            t0 = std::chrono::steady_clock::now();
+                        } else {
+                            VolumeGrid grid = loadVolume(o->file, lopt);
+                            stats.add("load_ms", msSince(t0));
+                            t0 = std::chrono::steady_clock::now();
+                            try {
+                                vol = brickVolume(grid, true);
+                            } catch (const Error& e) {
+                                throw Error(o->file, e.what());
+                            }
                         }
+                        const auto [lo, hi] = vol.valueRange();
                         const auto window = resolveWindow(tf, lo, hi, o->window, o->level);
                         const TFTable table = buildTable(tf, window, o->step);
                         rs.iso = o->iso ? *o->iso : (lo <= -500.0f ? 300.0f : lo + 0.4f * (hi - lo));
-                        stats.add("voxels", (unsigned long long)grid.voxelCount());
-                        stats.add("memory_mb", double(grid.memoryBytes()) / 1048576.0);
+                        stats.add("voxels", (unsigned long long)vol.voxelCount());
+                        stats.add("bricks_stored", (unsigned long long)vol.storedBricks());
+                        stats.add("memory_mb", double(vol.memoryBytes()) / 1048576.0);
                         gVolumeCounters.reset();
-                        withVolumeScene(grid, table, mc, rs, [&](const auto& scene) {
+                        withVolumeScene(vol, table, rs, [&](const auto& scene) {
                             stats.add("build_ms", msSince(t0));
                             const CameraFrame frame = c.frame(scene.bounds(), {0.45f, -1.0f, 0.35f}, {0, 0, 1});
                             t0 = std::chrono::steady_clock::now();

@@ -13,7 +13,6 @@
 #include "core/render/pixel_center_sampler.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/render/tile_scheduler.h"
-#include "volume/macrocell_grid.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
@@ -39,8 +38,8 @@ TFTable flatTable(float lo, float hi, float opacity, float step) {
 
 template <class T>
 void checkTrilinear(VolumeGrid g, const std::function<float(float, float, float)>& f, float tol) {
-    const MacrocellGrid mc = buildMacrocells(g);
-    const VolumeScene<T> s(g, flatTable(0, 1, 0.5f, 0.5f), mc, {});
+    const BrickedVolume bv = brickVolume(g);
+    const VolumeScene<T> s(bv, flatTable(0, 1, 0.5f, 0.5f), {});
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (int it = 0; it < 200; ++it) {
@@ -83,12 +82,12 @@ struct Rendered {
 
 template <int N>
 Rendered render(const VolumeGrid& g, const TransferFunction& tf, VolumeRenderSettings rs, int w = 128, int h = 128) {
-    const MacrocellGrid mc = buildMacrocells(g);
-    const VolumeSummary sum = summarize(g, 2);
-    const TFTable table = buildTable(tf, resolveWindow(tf, sum.lo, sum.hi, std::nullopt, std::nullopt), rs.stepVoxels);
-    if (rs.mode == VolumeMode::Iso) rs.iso = sum.lo + 0.4f * (sum.hi - sum.lo);
+    const BrickedVolume bv = brickVolume(g);
+    const auto [lo, hi] = bv.valueRange();
+    const TFTable table = buildTable(tf, resolveWindow(tf, lo, hi, std::nullopt, std::nullopt), rs.stepVoxels);
+    if (rs.mode == VolumeMode::Iso) rs.iso = lo + 0.4f * (hi - lo);
     Rendered out{w, h, {}, 0, 0};
-    withVolumeScene(g, table, mc, rs, [&](const auto& scene) {
+    withVolumeScene(bv, table, rs, [&](const auto& scene) {
         const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, float(w) / float(h), {0.45f, -1.0f, 0.35f}, {0, 0, 1}), w, h);
         RGBAFramebuffer fb(w, h);
         const RayTracingRenderer<PixelCenterSampler, VolumeIntegrator> r{};
@@ -141,14 +140,13 @@ TEST(VolumeSampling, TrilinearMatchesLinearFieldsU8) {
 // depth: relative error <= 1e-3. Other steps: |ln T - ln T_exact| <= sigma * step (the
 // last sample covers at most one step past the end).
 TEST(VolumeDVR, SlabTransmittanceMatchesClosedForm) {
-    const VolumeGrid g = makeSlab(9, 9, 65, 0, 64, 255);
-    const MacrocellGrid mc = buildMacrocells(g);
+    const BrickedVolume g = brickVolume(makeSlab(9, 9, 65, 0, 64, 255));
     const float a = 0.02f, sigma = -std::log(1.0f - a), d = 64.0f;
     const float exact = std::exp(-sigma * d);
     for (float step : {0.25f, 0.5f, 1.0f, 2.0f, 0.3f, 0.7f}) {
         VolumeRenderSettings rs;
         rs.stepVoxels = step;
-        const VolumeScene<uint8_t> s(g, flatTable(0, 255, a, step), mc, rs);
+        const VolumeScene<uint8_t> s(g, flatTable(0, 255, a, step), rs);
         RayPacket<kW> rays;
         for (int i = 0; i < kW; ++i) rays.setLane(i, {1.0f + 6.0f * float(i) / kW, 4.0f, -5.0f}, {0, 0, 1});
         rays.finalize();
@@ -217,3 +215,43 @@ TEST_P(ToothRegression, MatchesReference) {
     test::expectMatchesReference(std::string(RTFACT_TEST_DATA) + "/tooth_" + mode + ".png", r.w, r.h, r.rgba);
 }
 INSTANTIATE_TEST_SUITE_P(Modes, ToothRegression, ::testing::Values("dvr", "shaded", "mip", "iso"));
+
+TEST(VolumeBricks, MatchDenseGridAndShareZeroBricks) {
+    VolumeGrid g = makeSheppLogan(37, Storage::U16);  // not a multiple of the brick size
+    const BrickedVolume b = brickVolume(g);
+    for (int k = 0; k < 37; ++k)
+        for (int j = 0; j < 37; ++j)
+            for (int i = 0; i < 37; ++i) ASSERT_EQ(b.stored(i, j, k), g.stored(g.index(i, j, k))) << i << "," << j << "," << k;
+    EXPECT_LT(b.storedBricks(), b.brickCount());  // the air around the phantom shares brick 0
+    EXPECT_LE(double(b.memoryBytes()), 1.5 * double(g.voxelCount() * 2) + 4096.0);
+}
+
+// OpenVDB input is bricked from the sparse tree; it must render like the densified grid.
+TEST(VolumeBricks, SparseVdbRendersLikeDense) {
+    const std::string p = std::string(RTFACT_SHARED_DATA) + "/volumes/bonsai_ct_density.vdb";
+    if (!std::filesystem::exists(p)) GTEST_SKIP() << "shared datasets not present: " << p;
+    VolumeLoadOptions o;
+    o.progress = false;
+    const BrickedVolume sparse = loadVDBBricked(p, o);
+    VolumeGrid dense = loadVolume(p, o);
+    const BrickedVolume fromDense = brickVolume(dense);
+    ASSERT_EQ(sparse.dims[2], fromDense.dims[2]);
+    // bricks touching a leaf node (some all zero) but far fewer than the dense brick grid
+    EXPECT_LE(double(sparse.storedBricks()), 1.25 * double(fromDense.storedBricks()));
+    EXPECT_LT(sparse.storedBricks(), sparse.brickCount() / 2);
+    const TransferFunction tf = transferFunctionPreset("viridis");
+    const TFTable table = buildTable(tf, {0.0f, 1.0f}, 0.5f);
+    std::vector<float> img[2];
+    int idx = 0;
+    for (const BrickedVolume* v : {&sparse, &fromDense}) {
+        withVolumeScene(*v, table, {}, [&](const auto& scene) {
+            const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}), 64, 64);
+            RGBAFramebuffer fb(64, 64);
+            RenderOptions ro;
+            ro.progress = false;
+            renderImage<16>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+            img[idx++] = fb.resolved(1);
+        });
+    }
+    EXPECT_LE(maxAbsDiff(img[0], img[1]), 1e-6f);
+}

@@ -1,0 +1,147 @@
+#include "volume/brick_volume.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <limits>
+
+#include "core/util/error.h"
+
+namespace rtfact::volume {
+
+float BrickedVolume::stored(int i, int j, int k) const {
+    const int bx = std::min(i / kCells, nb[0] - 1), by = std::min(j / kCells, nb[1] - 1), bz = std::min(k / kCells, nb[2] - 1);
+    const size_t n = size_t(brickStart[brickIndex(bx, by, bz)]) + size_t(i - bx * kCells) + size_t(j - by * kCells) * kEdge +
+                     size_t(k - bz * kCells) * kEdge * kEdge;
+    switch (storage) {
+        case Storage::U8: return float(pool[n]);
+        case Storage::U16: return float(data<uint16_t>()[n]);
+        default: return data<float>()[n];
+    }
+}
+
+std::pair<float, float> BrickedVolume::valueRange() const {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (size_t b = 0; b < brickCount(); ++b) {
+        lo = std::min(lo, std::min(cellLo[b] * scale + offset, cellHi[b] * scale + offset));
+        hi = std::max(hi, std::max(cellLo[b] * scale + offset, cellHi[b] * scale + offset));
+    }
+    if (lo > hi) lo = hi = 0;
+    return {lo, hi};
+}
+
+void BrickBuilder::init(BrickedVolume& v, const int dims[3], Storage s) {
+    for (int a = 0; a < 3; ++a) {
+        if (dims[a] < 2) throw Error("", "cannot render a volume with fewer than 2 voxels along an axis");
+        v.dims[a] = dims[a];
+        v.nb[a] = (dims[a] - 1 + BrickedVolume::kCells - 1) / BrickedVolume::kCells;
+    }
+    v.storage = s;
+    const size_t nbricks = v.brickCount();
+    v.brickStart.assign(nbricks, 0);
+    v.cellLo.assign(nbricks, 0.0f);
+    v.cellHi.assign(nbricks, 0.0f);
+    // brick 0: zeros, plus padding so wide gathers may over-read at the end
+    v.pool.assign(size_t(BrickedVolume::kBrick) * size_t(storageBytes(s)), 0);
+}
+
+void BrickBuilder::finish(BrickedVolume& v) {
+    if (v.pool.size() / size_t(storageBytes(v.storage)) > size_t(std::numeric_limits<int32_t>::max()) - 64)
+        throw Error("", "volume too large for 32-bit brick offsets");
+    // padding so wide gathers may over-read at the end (dense bricking allocates it)
+    if (v.pool.size() % (size_t(BrickedVolume::kBrick) * size_t(storageBytes(v.storage))) == 0) {
+        v.pool.resize(v.pool.size() + 64, 0);
+        v.pool.shrink_to_fit();
+    }
+}
+
+namespace {
+template <class T>
+void brickDense(VolumeGrid& g, BrickedVolume& v, bool release) {
+    const T* src = g.data<T>();
+    const size_t nb = v.brickCount();
+    // Pass 1: which bricks are all zero (share brick 0) and where the others go.
+    std::vector<uint8_t> zero(nb, 0);
+    tbb::parallel_for(size_t(0), nb, [&](size_t b) {
+        const int bx = int(b % size_t(v.nb[0])), by = int((b / size_t(v.nb[0])) % size_t(v.nb[1])), bz = int(b / (size_t(v.nb[0]) * size_t(v.nb[1])));
+        bool allZero = true;
+        for (int k = 0; k < BrickedVolume::kEdge && allZero; ++k) {
+            const int z = std::min(bz * BrickedVolume::kCells + k, g.dims[2] - 1);
+            for (int j = 0; j < BrickedVolume::kEdge && allZero; ++j) {
+                const int y = std::min(by * BrickedVolume::kCells + j, g.dims[1] - 1);
+                const T* row = src + g.index(0, y, z);
+                for (int i = 0; i < BrickedVolume::kEdge; ++i)
+                    if (row[std::min(bx * BrickedVolume::kCells + i, g.dims[0] - 1)] != T(0)) {
+                        allZero = false;
+                        break;
+                    }
+            }
+        }
+        zero[b] = allZero;
+    });
+    std::vector<int64_t> start(nb, 0);
+    int64_t next = BrickedVolume::kBrick;
+    for (size_t b = 0; b < nb; ++b)
+        if (!zero[b]) {
+            start[b] = next;
+            next += BrickedVolume::kBrick;
+        }
+    if (next > int64_t(std::numeric_limits<int32_t>::max()) - 64) throw Error("", "volume too large for 32-bit brick offsets");
+    v.pool.assign(size_t(next) * sizeof(T) + 64, 0);
+    T* pool = reinterpret_cast<T*>(v.pool.data());
+    // Pass 2 by z-slabs of bricks, so the dense slab can be released behind us.
+    for (int bz = 0; bz < v.nb[2]; ++bz) {
+        tbb::parallel_for(0, v.nb[1], [&](int by) {
+            for (int bx = 0; bx < v.nb[0]; ++bx) {
+                const size_t b = v.brickIndex(bx, by, bz);
+                v.brickStart[b] = int32_t(start[b]);
+                if (zero[b]) continue;
+                T* dst = pool + start[b];
+                float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+                int n = 0;
+                for (int k = 0; k < BrickedVolume::kEdge; ++k) {
+                    const int z = std::min(bz * BrickedVolume::kCells + k, g.dims[2] - 1);
+                    for (int j = 0; j < BrickedVolume::kEdge; ++j) {
+                        const int y = std::min(by * BrickedVolume::kCells + j, g.dims[1] - 1);
+                        const T* row = src + g.index(0, y, z);
+                        for (int i = 0; i < BrickedVolume::kEdge; ++i, ++n) {
+                            const T s = row[std::min(bx * BrickedVolume::kCells + i, g.dims[0] - 1)];
+                            dst[n] = s;
+                            lo = std::min(lo, float(s));
+                            hi = std::max(hi, float(s));
+                        }
+                    }
+                }
+                v.cellLo[b] = lo;
+                v.cellHi[b] = hi;
+            }
+        });
+    }
+    (void)release;
+}
+}  // namespace
+
+BrickedVolume brickVolume(VolumeGrid& g, bool release) {
+    BrickedVolume v;
+    BrickBuilder::init(v, g.dims, g.storage);
+    v.spacing = g.spacing;
+    v.origin = g.origin;
+    v.scale = g.scale;
+    v.offset = g.offset;
+    v.sourceType = g.sourceType;
+    switch (g.storage) {
+        case Storage::U8: brickDense<uint8_t>(g, v, release); break;
+        case Storage::U16: brickDense<uint16_t>(g, v, release); break;
+        default: brickDense<float>(g, v, release); break;
+    }
+    if (release) {
+        g.bytes.clear();
+        g.bytes.shrink_to_fit();
+    }
+    BrickBuilder::finish(v);
+    return v;
+}
+
+}  // namespace rtfact::volume

@@ -1,0 +1,94 @@
+// BrickedVolume: the render-time layout of a volume. Voxels live in bricks of 8^3 cells
+// stored as 9^3 samples (one shared layer with the next brick), so every trilinear cell
+// lies inside one brick and neighbouring rays hit the same few cache lines; bricks that
+// are entirely zero share one brick, which makes sparse (OpenVDB) volumes cheap without
+// a dense copy. The brick grid doubles as the macrocell grid for empty-space skipping:
+// per brick the min/max of its 9^3 samples (everything a sample inside it reads).
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/math/aabb.h"
+#include "volume/volume_grid.h"
+
+namespace rtfact::volume {
+
+struct BrickedVolume {
+    static constexpr int kCells = 8;                      // cells per brick edge
+    static constexpr int kEdge = kCells + 1;              // samples per brick edge
+    static constexpr int kBrick = kEdge * kEdge * kEdge;  // samples per brick
+
+    int dims[3] = {0, 0, 0};
+    int nb[3] = {0, 0, 0};  // bricks per axis
+    Vec3f spacing{1, 1, 1}, origin{0, 0, 0};
+    Storage storage = Storage::U8;
+    float scale = 1.0f, offset = 0.0f;
+    std::string sourceType;
+    std::vector<uint8_t> pool;            // bricks of kBrick samples; brick 0 is all zero
+    std::vector<int32_t> brickStart;      // per brick: first sample in the pool
+    std::vector<float> cellLo, cellHi;    // per brick: stored min/max
+
+    size_t brickCount() const { return size_t(nb[0]) * size_t(nb[1]) * size_t(nb[2]); }
+    size_t brickIndex(int bx, int by, int bz) const { return (size_t(bz) * size_t(nb[1]) + size_t(by)) * size_t(nb[0]) + size_t(bx); }
+    size_t voxelCount() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
+    size_t storedBricks() const { return pool.size() / (size_t(kBrick) * size_t(storageBytes(storage))); }
+    size_t memoryBytes() const {
+        return pool.capacity() + brickStart.capacity() * 4 + (cellLo.capacity() + cellHi.capacity()) * 4;
+    }
+    template <class T>
+    const T* data() const { return reinterpret_cast<const T*>(pool.data()); }
+    AABB bounds() const {
+        const Vec3f ext((dims[0] - 1) * spacing.x, (dims[1] - 1) * spacing.y, (dims[2] - 1) * spacing.z);
+        return {origin, origin + ext};
+    }
+    // Stored value at voxel (i, j, k) (for tests and tools, not the hot path).
+    float stored(int i, int j, int k) const;
+    // Data value range over all bricks.
+    std::pair<float, float> valueRange() const;
+};
+
+// Bricks a dense grid (parallel). `release` frees the grid's voxels as bricks are
+// made, so peak memory stays near one copy.
+BrickedVolume brickVolume(VolumeGrid& grid, bool release = false);
+inline BrickedVolume brickVolume(const VolumeGrid& grid) { return brickVolume(const_cast<VolumeGrid&>(grid), false); }
+
+// Allocation of bricks for sparse sources: call `reserve` with the number of non-zero
+// bricks, then fill them one by one.
+struct BrickBuilder {
+    // Sets up dims/nb/tables; the pool holds brick 0 (zeros).
+    static void init(BrickedVolume& v, const int dims[3], Storage s);
+    // Appends a brick filled by fill(i, j, k) -> stored value for local samples.
+    template <class F>
+    static void addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill);
+    static void finish(BrickedVolume& v);
+};
+
+template <class F>
+void BrickBuilder::addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill) {
+    const size_t bytes = size_t(BrickedVolume::kBrick) * size_t(storageBytes(v.storage));
+    const size_t start = v.pool.size();
+    v.pool.resize(start + bytes);
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    uint8_t* dst = v.pool.data() + start;
+    int n = 0;
+    for (int k = 0; k < BrickedVolume::kEdge; ++k)
+        for (int j = 0; j < BrickedVolume::kEdge; ++j)
+            for (int i = 0; i < BrickedVolume::kEdge; ++i, ++n) {
+                const float s = fill(bx * BrickedVolume::kCells + i, by * BrickedVolume::kCells + j, bz * BrickedVolume::kCells + k);
+                lo = std::min(lo, s);
+                hi = std::max(hi, s);
+                if (v.storage == Storage::U8) dst[n] = uint8_t(s);
+                else if (v.storage == Storage::U16) reinterpret_cast<uint16_t*>(dst)[n] = uint16_t(s);
+                else reinterpret_cast<float*>(dst)[n] = s;
+            }
+    const size_t b = v.brickIndex(bx, by, bz);
+    v.brickStart[b] = int32_t(start / size_t(storageBytes(v.storage)));
+    v.cellLo[b] = lo;
+    v.cellHi[b] = hi;
+}
+
+}  // namespace rtfact::volume
