@@ -25,6 +25,7 @@
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
 #include "core/util/progress.h"
+#include "points/huge_pages.h"
 #include "points/point_cloud_io.h"
 #include "points/point_scene.h"
 
@@ -221,7 +222,9 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
         // Build at all threads (the target is points/s on all cores).
         tbb::task_arena arena(all);
         for (int r = 0; r < std::max(1, std::min(repeat, 2)); ++r) {
-            std::vector<Disc> copy = discs;
+            std::vector<Disc> copy;
+            resizeHuge(copy, discs.size());
+            std::copy(discs.begin(), discs.end(), copy.begin());
             const auto t0 = Clock::now();
             arena.execute([&] { scene.build(std::move(copy), builder); });
             rtBuild = std::min(rtBuild, msSinceP(t0));

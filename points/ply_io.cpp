@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/util/error.h"
+#include "points/huge_pages.h"
 #include "points/point_cloud_io.h"
 #include "points/point_cloud_io_detail.h"
 
@@ -112,47 +113,68 @@ uint8_t colorByte(double v, ScalarType t) {
 
 // Collects one decoded point; finite check and origin shift happen in finish().
 void PointSink::reserve(size_t n, bool normals, bool colors, bool radius, bool intensity) {
-    pos.resize(n);
-    if (normals) nrm.resize(n);
-    if (colors) col.resize(n);
-    if (radius) rad.resize(n);
-    if (intensity) inten.resize(n);
+    resizeHuge(pos, n);
+    if (normals) resizeHuge(nrm, n);
+    if (colors) resizeHuge(col, n);
+    if (radius) resizeHuge(rad, n);
+    if (intensity) resizeHuge(inten, n);
 }
+
+namespace {
+bool finite3(const std::array<double, 3>& p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+}  // namespace
 
 void PointSink::finish(const std::string& file, PointCloud& out) {
     const size_t n = pos.size();
     // Origin shift in double so that large (UTM) coordinates keep their precision.
     for (size_t i = 0; i < n; ++i) {
+        if (!finite3(pos[i])) continue;
         const auto& p = pos[i];
-        if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) {
-            if (std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) > 1e4)
-                out.origin = {std::round(p[0]), std::round(p[1]), std::round(p[2])};
-            break;
-        }
+        if (std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) > 1e4)
+            out.origin = {std::round(p[0]), std::round(p[1]), std::round(p[2])};
+        break;
     }
-    size_t kept = 0;
-    out.positions.reserve(n);
-    for (size_t i = 0; i < n; ++i) {
-        const auto& p = pos[i];
-        if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) continue;
-        out.positions.push_back(Vec3f(float(p[0] - out.origin[0]), float(p[1] - out.origin[1]), float(p[2] - out.origin[2])));
-        if (!nrm.empty()) {
-            Vec3f v = nrm[i];
-            const float l = length(v);
-            out.normals.push_back(std::isfinite(l) && l > 0 ? v * (1.0f / l) : Vec3f(0, 0, 0));
-        }
-        if (!col.empty()) out.colors.push_back(col[i]);
-        if (!rad.empty()) out.radii.push_back(std::isfinite(rad[i]) && rad[i] > 0 ? rad[i] : 0.0f);
-        if (!inten.empty()) out.intensities.push_back(std::isfinite(inten[i]) ? inten[i] : 0.0f);
-        ++kept;
-    }
+    // Destination slot of each kept point: per-block counts, then prefix sums, so that
+    // the copy runs in parallel.
+    const size_t block = 1 << 16, blocks = (n + block - 1) / block;
+    std::vector<size_t> start(blocks + 1, 0);
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+        size_t c = 0;
+        for (size_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) c += finite3(pos[i]);
+        start[b + 1] = c;
+    });
+    for (size_t b = 0; b < blocks; ++b) start[b + 1] += start[b];
+    const size_t kept = start[blocks];
     out.droppedNonFinite = n - kept;
+    if (kept == 0) throw Error(file, n == 0 ? "empty point cloud" : "no point with finite coordinates");
+    resizeHuge(out.positions, kept);
+    if (!nrm.empty()) resizeHuge(out.normals, kept);
+    if (!col.empty()) out.colors.resize(kept);
+    if (!rad.empty()) out.radii.resize(kept);
+    if (!inten.empty()) out.intensities.resize(kept);
+    const std::array<double, 3> o = out.origin;
+    tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+        size_t k = start[b];
+        for (size_t i = b * block, e = std::min(n, (b + 1) * block); i < e; ++i) {
+            const auto& p = pos[i];
+            if (!finite3(p)) continue;
+            out.positions[k] = Vec3f(float(p[0] - o[0]), float(p[1] - o[1]), float(p[2] - o[2]));
+            if (!nrm.empty()) {
+                const Vec3f v = nrm[i];
+                const float l = length(v);
+                out.normals[k] = std::isfinite(l) && l > 0 ? v * (1.0f / l) : Vec3f(0, 0, 0);
+            }
+            if (!col.empty()) out.colors[k] = col[i];
+            if (!rad.empty()) out.radii[k] = std::isfinite(rad[i]) && rad[i] > 0 ? rad[i] : 0.0f;
+            if (!inten.empty()) out.intensities[k] = std::isfinite(inten[i]) ? inten[i] : 0.0f;
+            ++k;
+        }
+    });
     pos = {};
     nrm = {};
     col = {};
     rad = {};
     inten = {};
-    if (kept == 0) throw Error(file, n == 0 ? "empty point cloud" : "no point with finite coordinates");
 }
 
 }  // namespace detail

@@ -12,6 +12,7 @@
 
 #include "core/util/error.h"
 #include "core/util/progress.h"
+#include "points/huge_pages.h"
 #include "points/point_prepare.h"
 
 namespace rtfact::points {
@@ -117,7 +118,8 @@ ColorMode parseColorMode(const std::string& s) {
 
 std::vector<Disc> makeDiscs(const PointCloud& c, ColorMode mode) {
     const size_t n = c.size();
-    std::vector<Disc> d(n);
+    std::vector<Disc> d;
+    resizeHuge(d, n);
     float iLo = 0, iHi = 1;
     if (mode == ColorMode::Intensity && c.intensities.size() == n) {
         iLo = *std::min_element(c.intensities.begin(), c.intensities.end());

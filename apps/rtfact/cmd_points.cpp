@@ -25,7 +25,7 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
         float radius = 0.0f;
         float radiusFactor = 1.0f;
         std::string normals = "auto";
-        float lodQuality = 1.0f;
+        float lodQuality = 2.0f;
         std::string lod = "on";
         std::string color = "rgb";
         std::string integrator = "eyelight";
