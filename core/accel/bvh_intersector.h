@@ -43,9 +43,11 @@ struct BVHIntersector {
         constexpr int W = Packet<N>::W;
         PacketBounds pb;
         bool frustum = false;
+        bool neg[3] = {false, false, false};
         if constexpr (C >= 4) {
             pb = rays.bounds(active);
             frustum = pb.uniformSigns;
+            for (int a = 0; a < 3; ++a) neg[a] = pb.invDirHi[a] < 0.0f;
         }
         struct Entry {
             uint32_t node, first;
@@ -57,10 +59,17 @@ struct BVHIntersector {
             const Entry e = stack[--sp];
             const BVHNode& node = bvh.nodes[e.node];
             int k = int(e.first);
-            if (none(chunkHitsBox<CommonOrigin>(node.lo, node.hi, rays, hit.t, k))) {
+            // Sign-uniform packets know their near and far planes per axis.
+            auto hits = [&](int kk) {
+                if constexpr (C >= 4) {
+                    if (frustum) return any(chunkHitsBoxSigned<CommonOrigin>(node.lo, node.hi, rays, hit.t, kk, neg));
+                }
+                return any(chunkHitsBox<CommonOrigin>(node.lo, node.hi, rays, hit.t, kk));
+            };
+            if (!hits(k)) {
                 if (frustum && packetMissesBox(node.lo, node.hi, pb, pb.tMaxHi)) continue;
                 for (++k; k < C; ++k)
-                    if (any(chunkHitsBox<CommonOrigin>(node.lo, node.hi, rays, hit.t, k))) break;
+                    if (hits(k)) break;
                 if (k == C) continue;
             }
             if (node.isLeaf()) {
@@ -79,7 +88,7 @@ struct BVHIntersector {
             }
             // Near child first, judged by the first lane of the first active chunk.
             uint32_t nearChild = uint32_t(node.ofs), farChild = nearChild + 1;
-            if (rays.dir[node.axis()][k * W] < 0.0f) std::swap(nearChild, farChild);
+            if (frustum ? neg[node.axis()] : rays.dir[node.axis()][k * W] < 0.0f) std::swap(nearChild, farChild);
             stack[sp++] = {farChild, uint32_t(k)};
             stack[sp++] = {nearChild, uint32_t(k)};
         }

@@ -34,6 +34,32 @@ RTFACT_INLINE Mask<Packet<N>::W> chunkHitsBox(const Vec3f& lo, const Vec3f& hi, 
     return entry <= exit;
 }
 
+// The same test for packets whose active rays share direction signs (neg[a]: negative
+// along axis a): the near and far planes are known, so no min/max per axis is needed.
+// Inactive lanes (tFar = -inf) still fail whatever their signs.
+template <bool CommonOrigin, int N>
+RTFACT_INLINE Mask<Packet<N>::W> chunkHitsBoxSigned(const Vec3f& lo, const Vec3f& hi, const RayPacket<N>& rays,
+                                                    const Packet<N>& tFar, int k, const bool neg[3]) {
+    using P = Packet<Packet<N>::W>;
+    P tn[3], tf[3];
+    for (int a = 0; a < 3; ++a) {
+        const P& inv = rays.invDir[a].chunk(k);
+        const float nearP = neg[a] ? hi[a] : lo[a], farP = neg[a] ? lo[a] : hi[a];
+        if constexpr (CommonOrigin) {
+            const float o = rays.org[a][0];
+            tn[a] = P(nearP - o) * inv;
+            tf[a] = P(farP - o) * inv;
+        } else {
+            const P& o = rays.org[a].chunk(k);
+            tn[a] = (P(nearP) - o) * inv;
+            tf[a] = (P(farP) - o) * inv;
+        }
+    }
+    const P entry = max(max(tn[0], tn[1]), max(tn[2], rays.tMin.chunk(k)));
+    const P exit = min(min(tf[0], tf[1]), min(tf[2], tFar.chunk(k)));
+    return entry <= exit;
+}
+
 // True when no ray of the packet can hit the box: the latest possible entry over the
 // axes comes after the earliest possible exit. Needs uniform direction signs.
 inline bool packetMissesBox(const Vec3f& lo, const Vec3f& hi, const PacketBounds& pb, float tFarHi) {
