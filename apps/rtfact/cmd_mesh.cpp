@@ -1,6 +1,8 @@
 // `rtfact mesh FILE...`: triangle meshes on the core's BVH or kd-tree, rendered with the
-// core's eyelight/direct-light integrators or the surface library's AO integrator.
+// core's eyelight/direct-light integrators or the surface library's AO integrator and
+// path tracer.
 // `rtfact info` for mesh files.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -13,6 +15,7 @@
 #include "surfaces/ao_integrator.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
+#include "surfaces/path_integrator.h"
 
 namespace rtfact::app {
 
@@ -26,6 +29,7 @@ struct MeshOpts {
     std::string material;
     std::string bvh = "sah";
     int aoSamples = 16;
+    int maxDepth = 6;
 };
 
 // "point:x,y,z" or "dir:x,y,z"; point lights are scaled so that the scene centre
@@ -72,6 +76,15 @@ int renderMesh(const MeshOpts& o, std::shared_ptr<const Mesh> mesh, Stats& stats
     const CameraFrame frame = c.frame(box);
     if (o.integrator == "eyelight") {
         renderToFile(scene, EyeLightIntegrator{}, c, frame, stats);
+    } else if (o.integrator == "path") {
+        PathIntegrator pt;
+        pt.maxDepth = o.maxDepth;
+        pt.materials = PathIntegrator::fromMesh(*mesh);
+        // Without emitters (MTL Ke) the scene is lit by a bright sky.
+        const bool emitters = std::any_of(pt.materials.begin(), pt.materials.end(),
+                                          [](const PathMaterial& m) { return maxComponent(m.emission) > 0.0f; });
+        if (!emitters) pt.background = Vec3f(0.9f, 0.95f, 1.0f);
+        renderToFile(scene, pt, c, frame, stats);
     } else if (o.integrator == "ao") {
         AOIntegrator ao;
         ao.samples = o.aoSamples;
@@ -98,9 +111,10 @@ void addMeshCommand(CLI::App& app, CommandList& list) {
     CLI::App* cmd = app.add_subcommand("mesh", "Render triangle meshes (PLY, OBJ+MTL, STL, VTK, VTP)");
     o->common.addTo(*cmd, "mesh.png");
     cmd->add_option("FILE", o->files, "Mesh files (several are merged into one scene)")->required();
-    cmd->add_option("--integrator", o->integrator, "eyelight|direct|ao")
+    cmd->add_option("--integrator", o->integrator, "eyelight|direct|ao|path (path: progressive, use --spp)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"eyelight", "direct", "ao"}));
+        ->check(CLI::IsMember({"eyelight", "direct", "ao", "path"}));
+    cmd->add_option("--max-depth", o->maxDepth, "Path tracer: maximum bounces")->capture_default_str()->check(CLI::Range(1, 64));
     cmd->add_option("--light", o->lights, "Light point:x,y,z or dir:x,y,z (repeatable; default: a key light)");
     cmd->add_option("--material", o->material, "Override all materials: lambert[:r,g,b]");
     cmd->add_option("--bvh", o->bvh, "Acceleration structure: sah (binned SAH BVH) | kdtree (SAH kd-tree)")
