@@ -13,6 +13,7 @@ struct AOIntegrator {
     Vec3f background{0.05f, 0.05f, 0.07f};
     int samples = 8;
     float distance = 0.0f;  // 0: 20% of the scene's bounding-box diagonal
+    float offset = 4e-3f;   // ray start offset, in units of the diagonal
 
     template <int N, class Scene>
     Radiance<N> eval(const Scene& scene, RayPacket<N>& rays, const Mask<N>& active, const PixelSample<N>& ps) const {
@@ -39,8 +40,9 @@ struct AOIntegrator {
                 const Vec3f d = t * (rr * std::cos(phi)) + b * (rr * std::sin(phi)) + n * std::sqrt(std::max(0.0f, 1.0f - u1[i]));
                 ao.dir.setLane(i, d);
             }
-            ao.org = sp.p + sp.ng * Packet<N>(1e-4f * diag);
-            ao.tMin = Packet<N>(0.0f);
+            // Splats overlap their neighbours: start AO rays clear of the local surface.
+            ao.org = sp.p + sp.ng * Packet<N>(offset * diag);
+            ao.tMin = Packet<N>(offset * diag);
             ao.tMax = Packet<N>(dist);
             ao.commonOrigin = false;
             ao.finalize();

@@ -14,7 +14,7 @@ namespace rtfact::points {
 
 struct PrepareOptions {
     std::string normals = "auto";  // auto: from the file if present, else estimate | estimate | file
-    int normalK = 16;
+    int normalK = 24;  // noisy depth sensors need a wide neighbourhood
     float radius = 0.0f;        // > 0: the same radius for every point
     float radiusFactor = 1.0f;  // times the spacing estimate (or times the file's radii)
     int radiusK = 4;            // neighbour whose distance is the spacing
