@@ -44,8 +44,10 @@ struct VolumeIntegrator {
         return r;
     }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
+    // `knownStart`: the brick's first sample when the caller already looked it up.
     template <int W, class Scene>
-    static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p) {
+    static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p, const Packet<W, int32_t>* knownStart = nullptr) {
+        const bool haveStart = knownStart != nullptr;
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
         constexpr int E = Scene::kEdge;
@@ -54,7 +56,7 @@ struct VolumeIntegrator {
         // brick of the cell, then the cell's first sample inside the brick
         static_assert(Scene::kCells == 8);
         const I bx = shr3(ix), by = shr3(iy), bz = shr3(iz);
-        const I start = gather(s.brickStart, bx + by * I(s.nbx) + bz * I(s.nbxy));
+        const I start = haveStart ? *knownStart : gather(s.brickStart, bx + by * I(s.nbx) + bz * I(s.nbxy));
         const I base = start + (ix - bx * I(8)) + (iy - by * I(8)) * I(E) + (iz - bz * I(8)) * I(E * E);
         P a0, b0, a1, b1, a2, b2, a3, b3;
         fetchPair<typename Scene::Voxel, W>(s.voxels, base, a0, b0);
@@ -142,14 +144,23 @@ struct VolumeIntegrator {
         while (any(alive)) {
             Vec3<W> p = clampToGrid<W>(s, oi + di * t);
             Mask<W> samp = alive;
+            I start(0);
+            bool haveStart = false;
             // Empty-space skipping: jump to the first sample position past the cell.
             {
                 I c[3];
                 for (int a = 0; a < 3; ++a) c[a] = min(toInt(p[a] * P(invCell)), cellHi[a]);
                 const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
                 Mask<W> empty;
-                if (mode == VolumeMode::MIP) empty = alive & (gather(s.cellMax.data(), cid) <= maxv);
-                else empty = alive & (gather(s.cellFlags.data(), cid) == I(0));
+                if (mode == VolumeMode::MIP) {
+                    empty = alive & (gather(s.cellMax.data(), cid) <= maxv);
+                } else {
+                    // one gather gives the brick and (sign bit) whether it is empty
+                    const I info = gather(s.brickInfo.data(), cid);
+                    empty = alive & (info < I(0));
+                    start = info & I(0x7fffffff);
+                    haveStart = true;
+                }
                 if (any(empty)) {
                     P tExit(kInfinity);
                     for (int a = 0; a < 3; ++a) {
@@ -166,7 +177,8 @@ struct VolumeIntegrator {
             }
             if (any(samp)) {
                 sampleCount = sampleCount + select(samp, I(1), I(0));
-                const P v = sample<W>(s, p);
+                // sampling lanes have not moved since the brick lookup; the others are masked
+                const P v = haveStart ? sample<W>(s, p, &start) : sample<W>(s, p);
                 if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
                     const I idx = tfIndex<W>(s, v);
                     const P a = select(samp, gather(s.tf.a.data(), idx), P(0.0f));

@@ -47,6 +47,7 @@ struct VolumeScene {
     // Bricks are the macrocells: flags (non-zero = may contribute) for DVR/iso, maxima for MIP.
     int cells[3] = {0, 0, 0};
     std::vector<int32_t> cellFlags;
+    std::vector<int32_t> brickInfo;  // brick start, sign bit set when the brick is skipped
     std::vector<float> cellMax;
     float invCell = 1.0f / kCells;
 
@@ -86,6 +87,8 @@ struct VolumeScene {
             else if (s.mode == VolumeMode::Iso) on = std::min(lo, hi) <= s.iso && s.iso <= std::max(lo, hi);
             cellFlags[i] = (on || !s.skipping) ? 1 : 0;
         }
+        brickInfo.resize(nc);
+        for (size_t i = 0; i < nc; ++i) brickInfo[i] = v.brickStart[i] | (cellFlags[i] ? 0 : int32_t(0x80000000u));
         // MIP skips on stored maxima; a decreasing value map (negative scale) or no
         // skipping: never skip.
         if (v.scale < 0 || !s.skipping) std::fill(cellMax.begin(), cellMax.end(), std::numeric_limits<float>::infinity());
