@@ -16,6 +16,7 @@
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/path_integrator.h"
+#include "surfaces/whitted_integrator.h"
 
 namespace rtfact::app {
 
@@ -50,15 +51,32 @@ AnyLight parseLight(const std::string& s, const AABB& box) {
     throw CLI::ValidationError("--light", "expected point:x,y,z or dir:x,y,z, got '" + s + "'");
 }
 
-// --material lambert[:r,g,b] replaces every material by a diffuse one.
+// --material lambert[:r,g,b] | mirror[:r,g,b] | glass[:ior] replaces every material.
 void applyMaterial(Mesh& m, const std::string& spec) {
     if (spec.empty()) return;
     const size_t c = spec.find(':');
-    const std::string kind = spec.substr(0, c);
-    if (kind != "lambert") throw CLI::ValidationError("--material", "expected lambert[:r,g,b], got '" + spec + "'");
+    const std::string kind = spec.substr(0, c), arg = c == std::string::npos ? "" : spec.substr(c + 1);
     MeshMaterial mat;
-    mat.name = "lambert";
-    if (c != std::string::npos) mat.kd = parseVec3(spec.substr(c + 1), "--material");
+    mat.name = kind;
+    if (kind == "lambert") {
+        if (!arg.empty()) mat.kd = parseVec3(arg, "--material");
+    } else if (kind == "mirror") {
+        mat.illum = 3;
+        mat.kd = Vec3f(0.0f);
+        mat.ks = arg.empty() ? Vec3f(0.95f) : parseVec3(arg, "--material");
+    } else if (kind == "glass") {
+        mat.illum = 7;
+        mat.dissolve = 0.0f;
+        mat.kd = Vec3f(1.0f);
+        try {
+            mat.ior = arg.empty() ? 1.5f : std::stof(arg);
+        } catch (const std::exception&) {
+            throw CLI::ValidationError("--material", "glass:IOR expects a number, got '" + arg + "'");
+        }
+        if (!(mat.ior >= 1.0f && mat.ior <= 4.0f)) throw CLI::ValidationError("--material", "glass IOR must be in [1, 4]");
+    } else {
+        throw CLI::ValidationError("--material", "expected lambert[:r,g,b], mirror[:r,g,b] or glass[:ior], got '" + spec + "'");
+    }
     m.materials = {mat};
     m.materialIds.assign(m.triangles(), 0);
     m.colors.clear();
@@ -90,16 +108,26 @@ int renderMesh(const MeshOpts& o, std::shared_ptr<const Mesh> mesh, Stats& stats
         ao.samples = o.aoSamples;
         renderToFile(scene, ao, c, frame, stats);
     } else {
-        DirectLightIntegrator integ;
-        for (const std::string& l : o.lights) integ.lights.push_back(parseLight(l, box));
-        if (integ.lights.empty()) {
+        LightList lights;
+        for (const std::string& l : o.lights) lights.push_back(parseLight(l, box));
+        if (lights.empty()) {
             // Default: a key light above and to the left of the camera.
             const Vec3f e = box.extent();
             const float r = std::max(length(e), 1e-6f);
             const Vec3f p = frame.eye + normalize(frame.up) * (0.8f * r) - normalize(cross(frame.at - frame.eye, frame.up)) * (0.6f * r);
-            integ.lights.push_back(parseLight("point:" + std::to_string(p.x) + "," + std::to_string(p.y) + "," + std::to_string(p.z), box));
+            lights.push_back(parseLight("point:" + std::to_string(p.x) + "," + std::to_string(p.y) + "," + std::to_string(p.z), box));
         }
-        renderToFile(scene, integ, c, frame, stats);
+        if (o.integrator == "whitted") {
+            WhittedIntegrator w;
+            w.lights = lights;
+            w.maxDepth = o.maxDepth;
+            w.materials = PathIntegrator::fromMesh(*mesh);
+            renderToFile(scene, w, c, frame, stats);
+        } else {
+            DirectLightIntegrator integ;
+            integ.lights = lights;
+            renderToFile(scene, integ, c, frame, stats);
+        }
     }
     return 0;
 }
@@ -111,12 +139,12 @@ void addMeshCommand(CLI::App& app, CommandList& list) {
     CLI::App* cmd = app.add_subcommand("mesh", "Render triangle meshes (PLY, OBJ+MTL, STL, VTK, VTP)");
     o->common.addTo(*cmd, "mesh.png");
     cmd->add_option("FILE", o->files, "Mesh files (several are merged into one scene)")->required();
-    cmd->add_option("--integrator", o->integrator, "eyelight|direct|ao|path (path: progressive, use --spp)")
+    cmd->add_option("--integrator", o->integrator, "eyelight|direct|whitted|ao|path (path: progressive, use --spp)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"eyelight", "direct", "ao", "path"}));
-    cmd->add_option("--max-depth", o->maxDepth, "Path tracer: maximum bounces")->capture_default_str()->check(CLI::Range(1, 64));
+        ->check(CLI::IsMember({"eyelight", "direct", "whitted", "ao", "path"}));
+    cmd->add_option("--max-depth", o->maxDepth, "Whitted/path tracer: maximum ray depth")->capture_default_str()->check(CLI::Range(1, 64));
     cmd->add_option("--light", o->lights, "Light point:x,y,z or dir:x,y,z (repeatable; default: a key light)");
-    cmd->add_option("--material", o->material, "Override all materials: lambert[:r,g,b]");
+    cmd->add_option("--material", o->material, "Override all materials: lambert[:r,g,b] | mirror[:r,g,b] | glass[:ior] (mirror/glass: whitted, path)");
     cmd->add_option("--bvh", o->bvh, "Acceleration structure: sah (binned SAH BVH) | kdtree (SAH kd-tree)")
         ->capture_default_str()
         ->check(CLI::IsMember({"sah", "kdtree"}));

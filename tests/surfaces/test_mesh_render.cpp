@@ -15,6 +15,7 @@
 #include "core/render/tile_scheduler.h"
 #include "surfaces/ao_integrator.h"
 #include "surfaces/mesh_scene.h"
+#include "surfaces/whitted_integrator.h"
 #include "test_meshes.h"
 #include "tests/common/image_compare.h"
 
@@ -24,22 +25,28 @@ namespace {
 
 constexpr int kW = 96, kH = 72;
 
+// illum: 2 diffuse orange sphere, 3 mirror, 7 glass (for Whitted).
+std::shared_ptr<const Mesh> makeSceneMesh(int illum) {
+    Mesh a = test::heightField(24, 4);
+    Mesh s = test::uvSphere({0.1f, 0.55f, 0.0f}, 0.35f, 16);
+    s.materials = {MeshMaterial{}};
+    s.materials[0].kd = {0.9f, 0.4f, 0.2f};
+    s.materials[0].illum = illum;
+    s.materials[0].ks = Vec3f(0.9f);
+    s.materialIds.assign(s.triangles(), 0);
+    a.append(s);
+    return std::make_shared<const Mesh>(a);
+}
 std::shared_ptr<const Mesh> sceneMesh() {
-    static std::shared_ptr<const Mesh> m = [] {
-        Mesh a = test::heightField(24, 4);
-        Mesh s = test::uvSphere({0.1f, 0.55f, 0.0f}, 0.35f, 16);
-        s.materials = {MeshMaterial{}};
-        s.materials[0].kd = {0.9f, 0.4f, 0.2f};
-        s.materialIds.assign(s.triangles(), 0);
-        a.append(s);
-        return std::make_shared<const Mesh>(a);
-    }();
+    static std::shared_ptr<const Mesh> m = makeSceneMesh(2);
     return m;
 }
 
 template <class Structure, int N, class Integ>
-std::vector<float> render(const Integ& integ, int spp = 1) {
-    static const MeshScene<Structure> scene(sceneMesh());
+std::vector<float> render(const Integ& integ, int spp = 1, std::shared_ptr<const Mesh> mesh = nullptr) {
+    static const MeshScene<Structure> defaultScene(sceneMesh());
+    const MeshScene<Structure> other = mesh ? MeshScene<Structure>(mesh) : MeshScene<Structure>();
+    const MeshScene<Structure>& scene = mesh ? other : defaultScene;
     CameraFrame f;
     f.eye = {1.6f, 1.7f, 2.2f};
     f.at = {0.0f, 0.2f, 0.0f};
@@ -97,4 +104,21 @@ TEST(MeshRender, MetricDetectsChanges) {
     moved.lights[0] = PointLight{{1.5f, 3.0f, -1.0f}, Vec3f(25.0f)};
     const auto d = test::compareRGBA(render<BVH<Triangle>, 64>(direct()), render<BVH<Triangle>, 64>(moved), kW, kH, 8);
     EXPECT_GT(d.differentFraction, 0.05);
+}
+
+// Whitted: a mirror sphere and a glass sphere over the height field, direct light with
+// shadows on diffuse surfaces, depth limit 5.
+TEST(MeshRender, WhittedMirrorMatchesReference) {
+    const auto mesh = makeSceneMesh(3);
+    WhittedIntegrator w;
+    w.lights = direct().lights;
+    w.materials = PathIntegrator::fromMesh(*mesh);
+    test::expectMatchesReference(ref("mesh_whitted_mirror.png"), kW, kH, render<BVH<Triangle>, 64>(w, 1, mesh));
+}
+TEST(MeshRender, WhittedGlassMatchesReference) {
+    const auto mesh = makeSceneMesh(7);
+    WhittedIntegrator w;
+    w.lights = direct().lights;
+    w.materials = PathIntegrator::fromMesh(*mesh);
+    test::expectMatchesReference(ref("mesh_whitted_glass.png"), kW, kH, render<BVH<Triangle>, 64>(w, 1, mesh));
 }
