@@ -181,10 +181,15 @@ struct VolumeIntegrator {
                 const P v = haveStart ? sample<W>(s, p, &start) : sample<W>(s, p);
                 if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
                     const I idx = tfIndex<W>(s, v);
-                    const P a = select(samp, gather(s.tf.a.data(), idx), P(0.0f));
+                    // interleaved RGBA table: (b, a) first, (r, g) only if something is visible
+                    P tb, ta;
+                    fetchFloatPair<W>(s.tf.rgba.data(), idx * I(2) + I(1), tb, ta);
+                    const P a = select(samp, ta, P(0.0f));
                     const Mask<W> contrib = a > P(0.0f);
                     if (any(contrib)) {
-                        Vec3<W> c(gather(s.tf.r.data(), idx), gather(s.tf.g.data(), idx), gather(s.tf.b.data(), idx));
+                        P tr, tg;
+                        fetchFloatPair<W>(s.tf.rgba.data(), idx * I(2), tr, tg);
+                        Vec3<W> c(tr, tg, tb);
                         if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W>(s, p), d);
                         const P w = (P(1.0f) - alpha) * a;
                         col += c * w;
