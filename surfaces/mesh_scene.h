@@ -19,6 +19,7 @@
 #include "core/render/tracer.h"
 #include "core/util/huge_pages.h"
 #include "surfaces/mesh.h"
+#include "surfaces/textures.h"
 #include "surfaces/triangle.h"
 
 namespace rtfact {
@@ -59,6 +60,7 @@ struct MeshScene {
     Structure accel;
     Tracer<typename MeshIntersectorFor<Structure>::type> tracer;
     std::vector<Vec3f> materialColor;  // diffuse colour per material id
+    std::vector<ImageTexture> diffuseMaps;  // per material id (image empty: none)
     AABB box;
     template <int N>
     using Hit = TriangleIntersector::Hit<N>;
@@ -96,7 +98,14 @@ struct MeshScene {
         }
         box = mesh->bounds();
         materialColor.clear();
-        for (const MeshMaterial& mm : mesh->materials) materialColor.push_back(mm.kd);
+        diffuseMaps.clear();
+        for (const MeshMaterial& mm : mesh->materials) {
+            materialColor.push_back(mm.kd);
+            ImageTexture t;
+            // map_Kd images (meshes without uvs cannot use them).
+            if (!mm.diffuseMap.empty() && !mesh->uvs.empty()) t.image = std::make_shared<const Image>(readImage(mm.diffuseMap));
+            diffuseMaps.push_back(t);
+        }
     }
     AABB bounds() const { return box; }
     size_t memoryBytes() const { return accel.memoryBytes(); }
@@ -152,6 +161,7 @@ struct MeshScene {
                 const int32_t mat = m.materialIds[t];
                 sp.material[i] = mat;
                 col = col * materialColor[size_t(mat)];
+                if (hasUV && diffuseMaps[size_t(mat)].image) col = col * diffuseMaps[size_t(mat)].sample(sp.u[i], sp.v[i]);
             }
             sp.color.setLane(i, col);
         });
