@@ -35,7 +35,8 @@ struct BrickedVolume {
     size_t brickCount() const { return size_t(nb[0]) * size_t(nb[1]) * size_t(nb[2]); }
     size_t brickIndex(int bx, int by, int bz) const { return (size_t(bz) * size_t(nb[1]) + size_t(by)) * size_t(nb[0]) + size_t(bx); }
     size_t voxelCount() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
-    size_t storedBricks() const { return pool.size() / (size_t(kBrick) * size_t(storageBytes(storage))); }
+    // non-empty bricks (brick 0, the shared zero brick, not counted)
+    size_t storedBricks() const { return pool.size() / (size_t(kBrick) * size_t(storageBytes(storage))) - 1; }
     size_t memoryBytes() const {
         return pool.capacity() + brickStart.capacity() * 4 + (cellLo.capacity() + cellHi.capacity()) * 4;
     }
