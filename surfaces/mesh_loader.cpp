@@ -19,9 +19,9 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataReader.h>
-#include <vtkPLYReader.h>
 #include <vtkSTLReader.h>
 #include <vtkSmartPointer.h>
+#include <vtkLogger.h>
 #include <vtkStringOutputWindow.h>
 #include <vtkXMLPolyDataReader.h>
 
@@ -30,6 +30,8 @@
 
 namespace rtfact {
 namespace fs = std::filesystem;
+
+Mesh readPly(const std::string& file, const PlyHeader& h);  // ply_reader.cpp
 
 namespace {
 
@@ -78,12 +80,28 @@ struct VtkErrors {
 // Error instead.
 struct QuietVtkOutput {
     vtkSmartPointer<vtkOutputWindow> previous;
+    vtkNew<vtkStringOutputWindow> text;
+    vtkLogger::Verbosity verbosity;
     QuietVtkOutput() {
         previous = vtkOutputWindow::GetInstance();
-        vtkNew<vtkStringOutputWindow> quiet;
-        vtkOutputWindow::SetInstance(quiet);
+        vtkOutputWindow::SetInstance(text);
+        verbosity = vtkLogger::GetCurrentVerbosityCutoff();
+        vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
     }
-    ~QuietVtkOutput() { vtkOutputWindow::SetInstance(previous); }
+    ~QuietVtkOutput() {
+        vtkOutputWindow::SetInstance(previous);
+        vtkLogger::SetStderrVerbosity(verbosity);
+    }
+    // The last line of the first message VTK emitted (readers warn about truncated data
+    // and go on with what they have: for us that is an error).
+    std::string firstMessage() const {
+        std::string m = text->GetOutput();
+        const size_t end = m.find("\n\n");
+        if (end != std::string::npos) m = m.substr(0, end);
+        while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
+        const size_t nl = m.rfind('\n');
+        return nl == std::string::npos ? m : m.substr(nl + 1);
+    }
 };
 
 template <class Reader>
@@ -98,6 +116,7 @@ vtkPolyData* runReader(Reader* reader, const std::string& file, VtkErrors& errs)
     reader->SetFileName(file.c_str());
     reader->Update();
     if (!errs.first.empty()) throw Error(file, errs.first);
+    if (const std::string m = quiet.firstMessage(); !m.empty()) throw Error(file, m);
     vtkPolyData* pd = reader->GetOutput();
     if (!pd) throw Error(file, "reader produced no data");
     return pd;
@@ -478,8 +497,7 @@ Mesh loadMesh(const std::string& file) {
             !h.hasProperty("vertex", "z"))
             throw Error(file, "PLY file has no vertex element with x, y, z");
         if (h.count("face") == 0) throw Error(file, "PLY file has no faces (a point cloud, see `rtfact points`)");
-        vtkNew<vtkPLYReader> r;
-        m = fromPolyData(runReader(r.Get(), file, errs), file);
+        m = readPly(file, h);
     } else if (ext == ".stl") {
         checkStl(file);
         vtkNew<vtkSTLReader> r;

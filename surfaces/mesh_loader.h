@@ -1,6 +1,7 @@
 // Mesh files: PLY (ASCII/binary), OBJ (+MTL, textures), STL, VTK legacy and VTP. VTK's
-// readers are used for PLY/STL/VTK/VTP behind this header (after our own size checks);
-// OBJ/MTL is parsed here because VTK 9.1's OBJ reader drops usemtl material assignments.
+// readers are used for STL/VTK/VTP behind this header (after our own size checks); PLY
+// and OBJ/MTL are parsed by us: vtkPLYReader crashes on corrupted face lists and VTK
+// 9.1's OBJ reader drops usemtl material assignments.
 #pragma once
 #include <string>
 #include <vector>

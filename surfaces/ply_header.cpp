@@ -30,6 +30,12 @@ static int plyTypeBytes(const std::string& t) {
     return 0;
 }
 
+static char plyTypeKind(const std::string& t) {
+    if (t == "float" || t == "double" || t == "float32" || t == "float64") return 'f';
+    if (t[0] == 'u') return 'u';
+    return 'i';
+}
+
 bool isPlyFile(const std::string& file) {
     std::ifstream in(file, std::ios::binary);
     char m[4] = {};
@@ -89,9 +95,14 @@ PlyHeader readPlyHeader(const std::string& file) {
                 p.isList = true;
                 p.countBytes = plyTypeBytes(ct);
                 p.typeBytes = plyTypeBytes(it);
+                if (p.countBytes && p.typeBytes) {
+                    p.countKind = plyTypeKind(ct);
+                    p.typeKind = plyTypeKind(it);
+                }
                 if (!p.countBytes || !p.typeBytes) throw Error(file, "unknown PLY type in '" + line + "'");
             } else {
                 p.typeBytes = plyTypeBytes(t);
+                if (p.typeBytes) p.typeKind = plyTypeKind(t);
                 ls >> p.name;
                 if (!p.typeBytes) throw Error(file, "unknown PLY type '" + t + "'");
             }

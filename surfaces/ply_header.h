@@ -12,6 +12,8 @@ struct PlyProperty {
     bool isList = false;
     int typeBytes = 4;       // scalar type (or list item type) size in bytes
     int countBytes = 0;      // list count type size
+    char typeKind = 'f';     // 'i' signed, 'u' unsigned, 'f' floating point
+    char countKind = 'u';
 };
 
 struct PlyElement {

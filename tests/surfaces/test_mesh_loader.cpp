@@ -184,6 +184,17 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
     expectError(write("garbage.vtp", "<VTKFile type=\"PolyData\"><PolyData><Piece NumberOfPoints=\"3\" NumberOfPolys=\"1\">"
                                      "<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0"));
     expectError(write("unknown.xyz3", "1 2 3\n"), "unknown mesh format");
+    // Corrupted binary face list (count byte 3 -> 200): VTK's PLY reader crashed here.
+    std::string corrupt = binaryPly(1, false);
+    corrupt[corrupt.size() - 13] = char(200);
+    expectError(write("corrupt_list.ply", corrupt), "truncated");
+    // Out-of-range index in binary data.
+    std::string badIdx = binaryPly(1, false);
+    badIdx[badIdx.size() - 1] = char(0x7f);
+    expectError(write("bad_index.ply", badIdx), "refers to vertex");
+    // VTK legacy with fewer coordinates than declared: VTK only warns, we fail.
+    expectError(write("short.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\n"
+                                   "POLYGONS 1 4\n3 0 1 2\n"));
 }
 
 // The CLI: one line "rtfact: error: <file>: <what>" and exit code 1.
