@@ -226,19 +226,30 @@ bool checkVtkLegacy(const std::string& file, bool throwOnBad) {
         return false;
     }
     const bool binary = fmt.find("BINARY") != std::string::npos;
+    // Every count the reader will allocate for must fit in the file: at least one digit
+    // and a separator per value in ASCII, four bytes per value in binary. Lines inside
+    // binary blocks that happen to start with a keyword are vanishingly unlikely.
+    const long double perValue = binary ? 4 : 2;
     std::string line;
-    for (int i = 0; i < 16 && std::getline(in, line); ++i) {
+    while (std::getline(in, line)) {
         std::istringstream ls(line);
-        std::string kw, type;
-        unsigned long long n = 0;
+        std::string kw;
         ls >> kw;
-        if (kw != "POINTS") continue;
-        if (!(ls >> n >> type)) throw Error(file, "bad POINTS line '" + line + "'");
-        const long double need = (long double)n * 3 * (binary ? (type == "double" ? 8 : 4) : 2);
-        if (need > (long double)size)
-            throw Error(file, "truncated or lying VTK header: " + std::to_string(n) + " points cannot fit in " +
-                                  std::to_string(size) + " bytes");
-        break;
+        int perItem = 0;
+        if (kw == "POINTS") perItem = 3;
+        else if (kw == "POLYGONS" || kw == "TRIANGLE_STRIPS" || kw == "LINES" || kw == "VERTICES" ||
+                 kw == "POINT_DATA" || kw == "CELL_DATA")
+            perItem = 1;
+        else continue;
+        std::string tok;
+        while (ls >> tok) {
+            if (tok.empty() || tok.find_first_not_of("0123456789") != std::string::npos) continue;
+            if (tok.size() > 15) throw Error(file, "absurd count in '" + line.substr(0, 60) + "'");
+            const long double n = std::stold(tok);
+            if (n * perItem * perValue > (long double)size)
+                throw Error(file, "truncated or lying VTK header: '" + line.substr(0, 60) + "' cannot fit in " +
+                                      std::to_string(size) + " bytes");
+        }
     }
     return true;
 }

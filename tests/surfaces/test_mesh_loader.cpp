@@ -176,7 +176,9 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
     const uint32_t n = 100000000u;
     stl.append(reinterpret_cast<const char*>(&n), 4);
     expectError(write("lying.stl", stl + std::string(50, '\0')), "STL");
-    expectError(write("lying.vtk", "# vtk DataFile Version 3.0\nx\nBINARY\nDATASET POLYDATA\nPOINTS 900000000 float\n"), "points");
+    expectError(write("lying.vtk", "# vtk DataFile Version 3.0\nx\nBINARY\nDATASET POLYDATA\nPOINTS 900000000 float\n"), "lying");
+    expectError(write("lying_polys.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                                         "POLYGONS 900000000 900000000\n3 0 1 2\n"), "lying");
     expectError(write("notvtk.vtk", "hello\n"), "VTK");
     expectError(write("lying.vtp", "<VTKFile type=\"PolyData\"><PolyData><Piece NumberOfPoints=\"999999999999\" "
                                    "NumberOfPolys=\"1\"></Piece></PolyData></VTKFile>"),
