@@ -155,8 +155,9 @@ struct MeshScene {
                 sp.u[i] = bu;
                 sp.v[i] = bv;
             }
-            Vec3f col(1.0f);
-            if (hasColor) col = m.colors[i0] * bw + m.colors[i1] * bu + m.colors[i2] * bv;
+            // Meshes without materials get the default diffuse colour (MeshMaterial::kd).
+            Vec3f col = hasMat ? Vec3f(1.0f) : MeshMaterial{}.kd;
+            if (hasColor) col = col * (m.colors[i0] * bw + m.colors[i1] * bu + m.colors[i2] * bv);
             if (hasMat) {
                 const int32_t mat = m.materialIds[t];
                 sp.material[i] = mat;

@@ -81,9 +81,9 @@ struct PathIntegrator {
                 emitted.setLane(i, m.emission);
                 const Vec3f d = rays.dir.lane(i), n = sp.n.lane(i);
                 if (m.kind == PathMaterial::Lambert) {
-                    // The scene's colour already holds the material's kd (and vertex
-                    // colours); meshes without materials get the default albedo.
-                    weight.setLane(i, materials.empty() ? m.albedo * sp.color.lane(i) : sp.color.lane(i));
+                    // The scene's colour already holds the material's kd (the default
+                    // one for meshes without materials) and vertex colours.
+                    weight.setLane(i, sp.color.lane(i));
                     newDir.setLane(i, Vec3f(0.0f));  // sampled below in SIMD
                 } else if (m.kind == PathMaterial::Mirror) {
                     weight.setLane(i, m.albedo);
