@@ -126,25 +126,20 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                         stats.add("bricks_stored", (unsigned long long)vol.storedBricks());
                         stats.add("memory_mb", double(vol.memoryBytes()) / 1048576.0);
                         gVolumeCounters.reset();
+                        double renderMs = 0;
                         withVolumeScene(vol, table, rs, [&](const auto& scene) {
                             stats.add("build_ms", msSince(t0));
                             const CameraFrame frame = c.frame(scene.bounds(), {0.45f, -1.0f, 0.35f}, {0, 0, 1});
-                            t0 = std::chrono::steady_clock::now();
-                            renderToFile(scene, VolumeIntegrator{}, c, frame, stats);
+                            renderMs = renderToFile(scene, VolumeIntegrator{}, c, frame, stats).ms;
                         });
-                        // includes writing the image (render_ms itself is inside Stats)
-                        const double renderWallMs = msSince(t0);
                         const uint64_t samples = gVolumeCounters.samples, skipped = gVolumeCounters.skipped;
                         stats.add("samples", (unsigned long long)samples);
-                        stats.add("msamples_per_s", renderWallMs > 0 ? double(samples) / (renderWallMs * 1000.0) : 0.0);
+                        stats.add("msamples_per_s", renderMs > 0 ? double(samples) / (renderMs * 1000.0) : 0.0);
                         stats.add("skipped_fraction", samples + skipped ? double(skipped) / double(samples + skipped) : 0.0);
                         stats.add("tf", tf.name);
                         stats.add("window_lo", double(window.first));
                         stats.add("window_hi", double(window.second));
-                        if (c.stats) {
-                            // msamples_per_s from the render time recorded by renderToFile
-                            stats.print();
-                        }
+                        if (c.stats) stats.print();
                         return 0;
                     }});
 }

@@ -13,8 +13,9 @@
 
 namespace rtfact::app {
 
+// Returns the render statistics (render time excludes writing the image).
 template <class Integrator, class Scene>
-void renderToFile(const Scene& scene, const Integrator& integrator, const CommonOptions& o, const CameraFrame& frame,
+RenderStats renderToFile(const Scene& scene, const Integrator& integrator, const CommonOptions& o, const CameraFrame& frame,
                   Stats& stats) {
     const PinholeCamera cam(frame, o.width, o.height);
     // Accumulation buffer, resolved copy and 8-bit output.
@@ -37,6 +38,7 @@ void renderToFile(const Scene& scene, const Integrator& integrator, const Common
     stats.add("spp", o.spp);
     stats.add("width", o.width);
     stats.add("height", o.height);
+    return rs;
 }
 
 }  // namespace rtfact::app
