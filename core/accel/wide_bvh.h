@@ -1,0 +1,146 @@
+// WideBVH<Elem, K>: a K-ary BVH (K = 4, 8 or 16) collapsed from a binary BVHTopology,
+// for single-ray traversal that tests one ray against all K child boxes with one SIMD
+// op per slab. Nodes are structure-of-arrays (K floats per bound and axis); elements
+// are in the leaf order of the binary BVH, so a leaf is a contiguous range.
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/accel/bvh.h"
+#include "core/ray/ray_packet.h"
+
+namespace rtfact {
+
+template <int K>
+struct alignas(64) WideBVHNode {
+    static_assert(K == 4 || K == 8 || K == 16, "wide BVH arity must be 4, 8 or 16");
+    float lo[3][K];    // child box minima per axis (empty slots: +inf, never hit)
+    float hi[3][K];    // child box maxima per axis (empty slots: -inf)
+    int32_t child[K];  // inner child: node index; leaf child: first element
+    int32_t count[K];  // leaf child: element count (> 0); inner child or empty slot: 0
+
+    bool isLeaf(int i) const { return count[i] > 0; }
+    bool isEmpty(int i) const { return lo[0][i] > hi[0][i]; }
+    AABB box(int i) const { return {Vec3f(lo[0][i], lo[1][i], lo[2][i]), Vec3f(hi[0][i], hi[1][i], hi[2][i])}; }
+    void set(int i, const AABB& b, int32_t c, int32_t n) {
+        for (int a = 0; a < 3; ++a) {
+            lo[a][i] = b.lo[a];
+            hi[a][i] = b.hi[a];
+        }
+        child[i] = c;
+        count[i] = n;
+    }
+    void clear(int i) {
+        for (int a = 0; a < 3; ++a) {
+            lo[a][i] = kInfinity;
+            hi[a][i] = -kInfinity;
+        }
+        child[i] = -1;
+        count[i] = 0;
+    }
+};
+
+// Shape of a wide BVH: nodes (root at 0) and the element order of the leaves. An empty
+// tree has no nodes; otherwise the root always exists (a single-leaf tree is a root
+// with one leaf child).
+template <int K>
+struct WideBVHTopology {
+    static constexpr int arity = K;
+    std::vector<WideBVHNode<K>> nodes;
+    std::vector<uint32_t> order;  // order[i] = input index of the i-th element in leaf order
+    AABB box;
+
+    AABB bounds() const { return box; }
+    bool empty() const { return order.empty(); }
+};
+
+// Collapses a binary topology: each wide node starts from the two children of a binary
+// inner node and repeatedly opens the inner child with the largest surface area (the one
+// most likely to be visited) until it has K children.
+template <int K>
+WideBVHTopology<K> collapseBVH(const BVHTopology& bin) {
+    WideBVHTopology<K> w;
+    w.order = bin.order;
+    if (bin.nodes.empty() || bin.order.empty()) return w;
+    w.box = bin.nodes[0].box();
+    w.nodes.reserve(bin.nodes.size() / (K - 1) + 2);
+    // (wide node to fill, binary node it stands for)
+    std::vector<std::pair<uint32_t, uint32_t>> work;
+    w.nodes.emplace_back();
+    work.push_back({0u, 0u});
+    std::vector<uint32_t> kids;
+    kids.reserve(K);
+    while (!work.empty()) {
+        const auto [wi, bi] = work.back();
+        work.pop_back();
+        kids.clear();
+        const BVHNode& b = bin.nodes[bi];
+        if (b.isLeaf()) {
+            kids.push_back(bi);
+        } else {
+            kids.push_back(uint32_t(b.ofs));
+            kids.push_back(uint32_t(b.ofs) + 1);
+            while (int(kids.size()) < K) {
+                int best = -1;
+                float bestArea = -1.0f;
+                for (int i = 0; i < int(kids.size()); ++i) {
+                    const BVHNode& c = bin.nodes[kids[i]];
+                    if (c.isLeaf()) continue;
+                    const float a = c.box().surfaceArea();
+                    if (a > bestArea) bestArea = a, best = i;
+                }
+                if (best < 0) break;
+                const uint32_t open = kids[size_t(best)];
+                kids[size_t(best)] = uint32_t(bin.nodes[open].ofs);
+                kids.push_back(uint32_t(bin.nodes[open].ofs) + 1);
+            }
+        }
+        for (int i = 0; i < K; ++i) {
+            if (i >= int(kids.size())) {
+                w.nodes[wi].clear(i);
+                continue;
+            }
+            const BVHNode& c = bin.nodes[kids[size_t(i)]];
+            if (c.isLeaf()) {
+                w.nodes[wi].set(i, c.box(), c.ofs, c.count());
+            } else {
+                const uint32_t ni = uint32_t(w.nodes.size());
+                w.nodes.emplace_back();  // may reallocate: index, never hold references
+                w.nodes[wi].set(i, c.box(), int32_t(ni), 0);
+                work.push_back({ni, kids[size_t(i)]});
+            }
+        }
+    }
+    return w;
+}
+
+template <class Elem, int K = 8>
+struct WideBVH : WideBVHTopology<K> {
+    using Element = Elem;
+    std::vector<Elem> elems;  // in leaf order; elems[i] came from input index order[i]
+
+    size_t memoryBytes() const {
+        return this->nodes.size() * sizeof(WideBVHNode<K>) + elems.size() * sizeof(Elem) +
+               this->order.size() * sizeof(uint32_t);
+    }
+};
+
+// A wide BVH from a binary one (same leaves, same element order).
+template <int K, class Elem>
+WideBVH<Elem, K> collapseBVH(const BVH<Elem>& bvh) {
+    WideBVH<Elem, K> w;
+    static_cast<WideBVHTopology<K>&>(w) = collapseBVH<K>(static_cast<const BVHTopology&>(bvh));
+    w.elems = bvh.elems;
+    return w;
+}
+
+// Builds the binary BVH with `builder` and collapses it.
+template <Primitive Elem, int K = 8, class B>
+    requires Builder<B, BVHTopology>
+WideBVH<Elem, K> buildWideBVH(const B& builder, std::span<const Elem> elems) {
+    return collapseBVH<K>(buildBVH<Elem>(builder, elems));
+}
+
+}  // namespace rtfact

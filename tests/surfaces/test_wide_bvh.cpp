@@ -1,0 +1,205 @@
+// Wide BVH (K = 4, 8, 16) and its single-ray SIMD traversal: structural invariants of
+// the collapse (every element in exactly one leaf, child boxes inside their parents)
+// and nearest-hit / occlusion queries against brute force over all elements, for
+// spheres and triangles, at packet sizes 1, native and 64.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/accel/sah_bvh_builder.h"
+#include "core/accel/wide_bvh_intersector.h"
+#include "core/geometry/sphere.h"
+#include "surfaces/mesh_scene.h"
+#include "test_meshes.h"
+
+using namespace rtfact;
+
+namespace {
+
+static_assert(Intersector<WideBVHIntersector<TriangleIntersector>, WideBVH<Triangle, 8>>);
+static_assert(Intersector<WideBVHIntersector<SphereIntersector>, WideBVH<Sphere, 4>>);
+static_assert(Intersector<WideBVHIntersector<SphereIntersector>, WideBVH<Sphere, 16>>);
+
+std::vector<Sphere> testSpheres(int n) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), r(0.01f, 0.12f);
+    std::vector<Sphere> s(static_cast<size_t>(n));
+    for (Sphere& x : s) x = {Vec3f(u(rng), u(rng), u(rng)), r(rng)};
+    return s;
+}
+
+std::vector<Triangle> testTriangles() {
+    Mesh a = test::heightField(20, 4);
+    a.append(test::triangleSoup(500, 9));
+    a.append(test::uvSphere({0.2f, 0.5f, -0.1f}, 0.35f, 12));
+    return meshTriangles(a);
+}
+
+template <class Elem>
+auto elemIsect() {
+    if constexpr (std::is_same_v<Elem, Sphere>) return SphereIntersector{};
+    else return TriangleIntersector{};
+}
+
+bool inside(const AABB& in, const AABB& out) {
+    for (int a = 0; a < 3; ++a)
+        if (in.lo[a] < out.lo[a] || in.hi[a] > out.hi[a]) return false;
+    return true;
+}
+
+template <int K, class Elem>
+void checkStructure(const std::vector<Elem>& elems) {
+    const BVH<Elem> bin = buildBVH<Elem>(meshBVHBuilder(), std::span<const Elem>(elems));
+    const WideBVH<Elem, K> w = collapseBVH<K>(bin);
+    ASSERT_FALSE(w.nodes.empty());
+    std::vector<int> seen(elems.size(), 0);
+    std::vector<int> visits(w.nodes.size(), 0);
+    // (node, its box as stored in the parent)
+    std::vector<std::pair<int32_t, AABB>> todo{{0, w.bounds()}};
+    while (!todo.empty()) {
+        const auto [ni, box] = todo.back();
+        todo.pop_back();
+        ASSERT_LT(size_t(ni), w.nodes.size());
+        ++visits[size_t(ni)];
+        const WideBVHNode<K>& n = w.nodes[size_t(ni)];
+        int used = 0;
+        for (int c = 0; c < K; ++c) {
+            if (n.isEmpty(c)) continue;
+            ++used;
+            EXPECT_TRUE(inside(n.box(c), box)) << "child box outside its parent";
+            if (n.isLeaf(c)) {
+                for (int i = 0; i < n.count[c]; ++i) {
+                    const size_t e = size_t(n.child[c] + i);
+                    ASSERT_LT(e, w.elems.size());
+                    ++seen[w.order[e]];
+                    EXPECT_TRUE(inside(w.elems[e].bounds(), n.box(c))) << "element outside its leaf";
+                }
+            } else {
+                todo.push_back({n.child[c], n.box(c)});
+            }
+        }
+        // Greedy collapse fills nodes unless it runs out of inner children to open.
+        EXPECT_GE(used, ni == 0 && bin.nodes[0].isLeaf() ? 1 : 2);
+    }
+    for (size_t i = 0; i < seen.size(); ++i) ASSERT_EQ(seen[i], 1) << "element " << i << " reached " << seen[i] << " times";
+    for (size_t i = 0; i < visits.size(); ++i) ASSERT_EQ(visits[i], 1) << "node " << i << " reached " << visits[i] << " times";
+    // Collapsing a k-ary tree cuts the node count roughly by K / 2 at least.
+    EXPECT_LT(w.nodes.size() * 2, bin.nodes.size());
+}
+
+template <class Elem, int K, int N>
+void checkTraversal(const std::vector<Elem>& elems, bool commonOrigin) {
+    if constexpr (!simd::ValidPacketSize<N>) {
+        GTEST_SKIP() << "packet size " << N << " not supported by this build";
+    } else {
+        using EI = decltype(elemIsect<Elem>());
+        const WideBVH<Elem, K> w = buildWideBVH<Elem, K>(SAHBVHBuilder{}, std::span<const Elem>(elems));
+        const WideBVHIntersector<EI> isect;
+        std::mt19937 rng(N * 5 + K + commonOrigin);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f);
+        const int packets = std::max(4, 768 / N);
+        int hits = 0, occChecked = 0;
+        auto brute = [&](const RayPacket<1>& r) {
+            typename EI::template Hit<1> h;
+            h.t = r.tMax;
+            h.id = -1;
+            for (size_t i = 0; i < elems.size(); ++i) EI{}.template intersect<HitData::Distance>(elems[i], uint32_t(i), r, h, 0);
+            return std::pair<float, int>{int32_t(h.id) >= 0 ? float(h.t) : kInfinity, int32_t(h.id)};
+        };
+        for (int p = 0; p < packets; ++p) {
+            RayPacket<N> rays;
+            const Vec3f eye{2.5f * u(rng), 1.5f + u01(rng), 2.5f * u(rng)};
+            for (int i = 0; i < N; ++i) {
+                const Vec3f o = commonOrigin ? eye : Vec3f{2.0f * u(rng), 2.0f * u(rng), 2.0f * u(rng)};
+                const Vec3f t = Vec3f{u(rng), u(rng), u(rng)} * 0.8f;
+                rays.setLane(i, o, normalize(t - o), 0.0f, kInfinity);
+            }
+            // Some axis-parallel directions exercise the nudged reciprocals.
+            if (p % 5 == 2) rays.setLane(0, Vec3f(0.1f, 3.0f, -0.2f), Vec3f(0, -1, 0), 0.0f, kInfinity);
+            rays.commonOrigin = commonOrigin && p % 5 != 2;
+            rays.finalize();
+            Mask<N> active(true);
+            if (p % 3 == 1)
+                for (int i = 0; i < N; ++i) active.set(i, u01(rng) < 0.6f);
+            typename EI::template Hit<N> hit;
+            if (rays.commonOrigin) isect.template intersect<true, HitData::Shading>(w, rays, hit, active);
+            else isect.template intersect<false, HitData::Shading>(w, rays, hit, active);
+            for (int i = 0; i < N; ++i) {
+                if (!active[i]) {
+                    EXPECT_EQ(hit.id[i], -1) << "inactive lane " << i << " reported a hit";
+                    continue;
+                }
+                const auto [bt, bid] = brute(rays.lane(i));
+                if (bid < 0) {
+                    EXPECT_EQ(hit.id[i], -1) << "packet " << p << " lane " << i;
+                    continue;
+                }
+                ++hits;
+                ASSERT_GE(hit.id[i], 0) << "packet " << p << " lane " << i << " missed (brute t=" << bt << ")";
+                EXPECT_NEAR(hit.t[i], bt, 1e-5f * std::max(1.0f, bt));
+            }
+            RayPacket<N> seg = rays;
+            for (int i = 0; i < N; ++i) seg.tMax[i] = 3.0f * u01(rng);
+            const Mask<N> occ = isect.template occluded<false>(w, seg, active);
+            for (int i = 0; i < N; ++i) {
+                if (!active[i]) {
+                    EXPECT_FALSE(occ[i]);
+                    continue;
+                }
+                const auto [bt, bid] = brute(rays.lane(i));
+                if (std::fabs(bt - seg.tMax[i]) < 1e-4f) continue;  // too close to call
+                ++occChecked;
+                EXPECT_EQ(occ[i], bt < seg.tMax[i]) << "packet " << p << " lane " << i;
+            }
+        }
+        EXPECT_GT(hits, packets * N / 10);
+        EXPECT_GT(occChecked, packets * N / 2);
+    }
+}
+
+}  // namespace
+
+TEST(WideBVH, StructureSpheres) {
+    const auto s = testSpheres(3000);
+    checkStructure<4>(s);
+    checkStructure<8>(s);
+    checkStructure<16>(s);
+}
+TEST(WideBVH, StructureTriangles) {
+    const auto t = testTriangles();
+    checkStructure<4>(t);
+    checkStructure<8>(t);
+    checkStructure<16>(t);
+}
+TEST(WideBVH, SingleElementAndEmpty) {
+    const std::vector<Sphere> one{{Vec3f(0.0f), 1.0f}};
+    const WideBVH<Sphere> w = buildWideBVH<Sphere>(SAHBVHBuilder{}, std::span<const Sphere>(one));
+    ASSERT_EQ(w.nodes.size(), 1u);
+    RayPacket<1> r;
+    r.setLane(0, Vec3f(0, 0, -5), Vec3f(0, 0, 1));
+    r.finalize();
+    SphereIntersector::Hit<1> h;
+    WideBVHIntersector<SphereIntersector>{}.intersect<false, HitData::Shading>(w, r, h, Mask<1>(true));
+    EXPECT_EQ(int32_t(h.id), 0);
+    EXPECT_NEAR(float(h.t), 4.0f, 1e-5f);
+    const WideBVH<Sphere> none = buildWideBVH<Sphere>(SAHBVHBuilder{}, std::span<const Sphere>());
+    WideBVHIntersector<SphereIntersector>{}.intersect<false, HitData::Shading>(none, r, h, Mask<1>(true));
+    EXPECT_EQ(int32_t(h.id), -1);
+    EXPECT_FALSE(WideBVHIntersector<SphereIntersector>{}.occluded<false>(none, r, Mask<1>(true))[0]);
+}
+
+#define RTFACT_WIDE_TESTS(Name, Elem, elems, K)                                                          \
+    TEST(WideBVH, Name##K##Single) {                                                                     \
+        checkTraversal<Elem, K, 1>(elems, true);                                                         \
+        checkTraversal<Elem, K, 1>(elems, false);                                                        \
+    }                                                                                                    \
+    TEST(WideBVH, Name##K##Native) {                                                                     \
+        checkTraversal<Elem, K, simd::kNativeWidth>(elems, true);                                        \
+        checkTraversal<Elem, K, simd::kNativeWidth>(elems, false);                                       \
+    }                                                                                                    \
+    TEST(WideBVH, Name##K##Packet64) { checkTraversal<Elem, K, 64>(elems, false); }
+
+RTFACT_WIDE_TESTS(Spheres, Sphere, testSpheres(2000), 8)
+RTFACT_WIDE_TESTS(Spheres, Sphere, testSpheres(2000), 4)
+RTFACT_WIDE_TESTS(Triangles, Triangle, testTriangles(), 8)
+RTFACT_WIDE_TESTS(Triangles, Triangle, testTriangles(), 16)
