@@ -1,12 +1,14 @@
 // Ambient occlusion: the fraction of a cosine-weighted hemisphere around each hit that
-// is open within `radius`. The AO rays of all lanes of a packet travel together, one
-// packet per sample direction, as occlusion queries.
+// is open within `radius`. The AO rays of all lanes of a packet go out together, one
+// packet per sample direction, as occlusion queries; they point in unrelated
+// directions, so by default they are traced one by one through the wide BVH.
 #pragma once
 #include <cmath>
 
 #include "core/concepts/integrator.h"
 #include "core/concepts/scene.h"
 #include "core/render/random.h"
+#include "surfaces/secondary_rays.h"
 
 namespace rtfact {
 
@@ -37,7 +39,8 @@ RTFACT_INLINE Vec3<N> cosineHemisphere(const Vec3<N>& n, const Packet<N>& u1, co
     return t * (r * c) + b * (r * s) + n * z;
 }
 
-struct AOIntegrator {
+template <SecondaryRayPolicy Secondary = WideSecondaryRays>
+struct AOIntegratorT {
     Vec3f background{0.05f, 0.05f, 0.07f};
     int samples = 16;     // AO rays per hit
     float radius = 0.0f;  // 0: 20% of the scene diagonal
@@ -65,7 +68,7 @@ struct AOIntegrator {
             const uint32_t sample = uint32_t(ps.sample * samples + s);
             ao.dir = cosineHemisphere(sp.ng, hashToUnit(ps.px, ps.py, sample, 0), hashToUnit(ps.px, ps.py, sample, 1));
             ao.finalize();
-            const Mask<N> occ = scene.template occluded<N>(ao, found);
+            const Mask<N> occ = occludedSecondary<Secondary>(scene, ao, found);
             open = open + select(andNot(found, occ), Packet<N>(1.0f), Packet<N>(0.0f));
         }
         const Packet<N> f = open * Packet<N>(1.0f / float(std::max(samples, 1)));
@@ -74,5 +77,6 @@ struct AOIntegrator {
         return r;
     }
 };
+using AOIntegrator = AOIntegratorT<>;
 
 }  // namespace rtfact

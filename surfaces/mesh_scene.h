@@ -15,6 +15,7 @@
 #include "core/accel/kdtree_intersector.h"
 #include "core/accel/sah_bvh_builder.h"
 #include "core/accel/sah_kdtree_builder.h"
+#include "core/accel/wide_bvh_intersector.h"
 #include "core/concepts/scene.h"
 #include "core/render/tracer.h"
 #include "core/util/huge_pages.h"
@@ -54,11 +55,19 @@ inline InPlaceSAHBVHBuilder meshBVHBuilder() {
     return b;
 }
 
+// Arity of the wide BVH that serves incoherent single rays (one AVX/AVX-512 op per slab).
+inline constexpr int kMeshWideArity = 8;
+
 template <class Structure = BVH<Triangle>>
 struct MeshScene {
     std::shared_ptr<const Mesh> mesh;
     Structure accel;
     Tracer<typename MeshIntersectorFor<Structure>::type> tracer;
+    // Incoherent rays (AO, diffuse bounces) go one by one through a wide BVH collapsed
+    // from the packet BVH (BVH scenes only; kd-tree scenes answer them with `accel`).
+    bool buildWide = true;  // set before build()
+    WideBVH<Triangle, kMeshWideArity> wide;
+    Tracer<WideBVHIntersector<TriangleIntersector>> wideTracer;
     std::vector<Vec3f> materialColor;  // diffuse colour per material id
     std::vector<ImageTexture> diffuseMaps;  // per material id (image empty: none)
     AABB box;
@@ -92,6 +101,14 @@ struct MeshScene {
                     accel.elems[i] = {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
                 }
             });
+            wide = {};
+            if (buildWide) {
+                static_cast<WideBVHTopology<kMeshWideArity>&>(wide) = collapseBVH<kMeshWideArity>(static_cast<const BVHTopology&>(accel));
+                resizeHugePages(wide.elems, n);
+                tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
+                    for (size_t i = r.begin(); i != r.end(); ++i) wide.elems[i] = accel.elems[i];
+                });
+            }
         } else {
             const std::vector<Triangle> tris = meshTriangles(*mesh);
             accel = buildKdTree<Triangle>(SAHKdTreeBuilder{}, std::span<const Triangle>(tris));
@@ -108,7 +125,8 @@ struct MeshScene {
         }
     }
     AABB bounds() const { return box; }
-    size_t memoryBytes() const { return accel.memoryBytes(); }
+    size_t memoryBytes() const { return accel.memoryBytes() + (hasWide() ? wide.memoryBytes() : 0); }
+    bool hasWide() const { return !wide.nodes.empty(); }
 
     template <int N>
     Hit<N> intersect(const RayPacket<N>& rays, const Mask<N>& active) const {
@@ -120,6 +138,18 @@ struct MeshScene {
     }
     template <int N>
     Mask<N> occluded(const RayPacket<N>& rays, const Mask<N>& active) const {
+        return tracer.occluded(accel, rays, active);
+    }
+
+    // Incoherent rays: lane by lane through the wide BVH when it exists.
+    template <int N>
+    Hit<N> intersectIncoherent(const RayPacket<N>& rays, const Mask<N>& active) const {
+        if (hasWide()) return wideTracer.intersect(wide, rays, active);
+        return tracer.intersect(accel, rays, active);
+    }
+    template <int N>
+    Mask<N> occludedIncoherent(const RayPacket<N>& rays, const Mask<N>& active) const {
+        if (hasWide()) return wideTracer.occluded(wide, rays, active);
         return tracer.occluded(accel, rays, active);
     }
 

@@ -1,7 +1,8 @@
 // Progressive path tracer for mesh scenes: Lambertian, perfect mirror and dielectric
 // glass materials (from MeshMaterial: kd, ks/illum, dissolve/Ni), emission (Ke) as
 // area lights, and a constant environment. All lanes of a packet bounce together, so
-// secondary rays from different surfaces still travel as one (incoherent) packet.
+// secondary rays from different surfaces still travel as one (incoherent) packet; by
+// default those bounces are traced one by one through the scene's wide BVH.
 // Each --spp sample adds one path per pixel; the framebuffer averages them.
 #pragma once
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include "core/render/random.h"
 #include "surfaces/ao_integrator.h"
 #include "surfaces/mesh.h"
+#include "surfaces/secondary_rays.h"
 
 namespace rtfact {
 
@@ -40,7 +42,8 @@ struct PathMaterial {
     }
 };
 
-struct PathIntegrator {
+template <SecondaryRayPolicy Secondary = WideSecondaryRays>
+struct PathIntegratorT {
     Vec3f background{0.0f};  // constant environment radiance
     int maxDepth = 6;
     int rouletteDepth = 3;   // Russian roulette from this bounce on (unbiased)
@@ -60,7 +63,9 @@ struct PathIntegrator {
         Mask<N> alive = active;
         static const PathMaterial kDefault{};
         for (int depth = 0; depth < maxDepth && any(alive); ++depth) {
-            const auto hit = scene.template intersect<N>(rays, alive);
+            // Camera rays are coherent packets; bounces are not.
+            const auto hit = depth == 0 ? scene.template intersect<N>(rays, alive)
+                                        : intersectSecondary<Secondary>(scene, rays, alive);
             const Mask<N> found = alive & (hit.id != Packet<N, int32_t>(-1));
             if (depth == 0) out.depth = select(found, hit.t, out.depth);
             // Escaped paths see the environment.
@@ -146,5 +151,7 @@ struct PathIntegrator {
         return r;
     }
 };
+
+using PathIntegrator = PathIntegratorT<>;
 
 }  // namespace rtfact
