@@ -208,11 +208,11 @@ double psnr8(const Frame& a, const Frame& b) {
 
 template <int N>
 int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& cam, int w, int h, int all, int repeat,
-        std::vector<float> qualities, int leafSize, double loadMs) {
+        std::vector<float> qualities, std::vector<float> repScales, int leafSize, double loadMs) {
     const float quality = qualities.front();
     const size_t n = discs.size();
-    std::printf("file=%s\npoints=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nload_ms=%.1f\n", file.c_str(), n,
-                w, h, N, all, quality, loadMs);
+    std::printf("file=%s\npoints=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nrep_scale=%.3g\nload_ms=%.1f\n", file.c_str(), n,
+                w, h, N, all, quality, repScales.front(), loadMs);
     const std::vector<int> threadCounts = all > 1 ? std::vector<int>{1, all} : std::vector<int>{1};
     PointScene scene;
     LoDKdTreeBuilder builder;
@@ -256,7 +256,7 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
         for (int r = 0; r < repeat; ++r) {
             scene.setLoD(cam.cone(), 0.0f);
             full = std::min(full, timeTiles(T, w, h, [&](int x, int y) { rt.tile(ff, x, y); }));
-            scene.setLoD(cam.cone(), quality);
+            scene.setLoD(cam.cone(), quality, repScales.front());
             lod = std::min(lod, timeTiles(T, w, h, [&](int x, int y) { rt.tile(fl, x, y); }));
             emb = std::min(emb, timeTiles(T, w, h, [&](int x, int y) { em.tile(fe, x, y); }));
         }
@@ -271,13 +271,18 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
     std::printf("agreement_full_vs_embree: hit_diff_pixels=%zu psnr=%.2f\n", hitDiff, psnr8(ff, fe));
     std::printf("psnr_lod_vs_full=%.2f\n", psnr8(fl, ff));
     // Further qualities: all threads only.
-    for (size_t qi = 1; qi < qualities.size(); ++qi) {
-        const float q = qualities[qi];
-        double lod = 1e30;
-        scene.setLoD(cam.cone(), q);
-        for (int r = 0; r < repeat; ++r) lod = std::min(lod, timeTiles(all, w, h, [&](int x, int y) { rt.tile(fl, x, y); }));
-        std::printf("quality=%.3g threads=%d lod_frame_ms=%.1f lod_mrays=%.2f psnr_lod_vs_full=%.2f\n", q, all, lod, mr(lod), psnr8(fl, ff));
-    }
+    for (float s : repScales)
+        for (size_t qi = s == repScales.front() ? 1 : 0; qi < qualities.size(); ++qi) {
+            const float q = qualities[qi];
+            double lod = 1e30, emb = 1e30;
+            scene.setLoD(cam.cone(), q, s);
+            for (int r = 0; r < repeat; ++r) {
+                lod = std::min(lod, timeTiles(all, w, h, [&](int x, int y) { rt.tile(fl, x, y); }));
+                emb = std::min(emb, timeTiles(all, w, h, [&](int x, int y) { em.tile(fe, x, y); }));
+            }
+            std::printf("quality=%.3g rep_scale=%.3g threads=%d lod_frame_ms=%.1f embree_frame_ms=%.1f ratio_lod=%.3f lod_mrays=%.2f psnr_lod_vs_full=%.2f\n",
+                        q, s, all, lod, emb, emb / lod, mr(lod), psnr8(fl, ff));
+        }
     std::printf("ratio_full=%.3f\nratio_lod=%.3f\n", worstFull, worstLod);
     std::printf("(ratios: Embree frame time / RTfact frame time, the worse of 1 and %d threads)\n", all);
     return 0;
@@ -289,7 +294,7 @@ int benchPoints(int argc, char** argv) {
     CLI::App app{"RTfact LoD kd-tree discs vs Embree oriented-disc points", "rtfact-bench points"};
     std::string file, eye, at, up, size = "1024x1024", normals = "auto";
     float fov = 45.0f, radius = 0.0f, radiusFactor = 1.0f;
-    std::vector<float> quality{1.0f};
+    std::vector<float> quality{1.0f}, repScale{1.0f};
     int threads = 0, packet = 16, repeat = 3, leafSize = 8;
     app.add_option("FILE", file, "Point cloud (.ply .pcd .xyz .pts)")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
@@ -303,6 +308,9 @@ int benchPoints(int argc, char** argv) {
     app.add_option("--lod-quality", quality, "LoD quality for the LoD run (more values: extra LoD runs at all threads)")
         ->capture_default_str()
         ->check(CLI::Range(0.0f, 64.0f));
+    app.add_option("--rep-scale", repScale, "Hit radius of representatives / covering radius (more values: extra LoD runs)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1f, 1.0f));
     app.add_option("--leaf-size", leafSize, "Maximum points per leaf")->capture_default_str()->check(CLI::Range(1, 64));
     app.add_option("--radius", radius, "Disc radius for every point");
     app.add_option("--radius-factor", radiusFactor, "Scale of the radii")->capture_default_str();
@@ -335,10 +343,10 @@ int benchPoints(int argc, char** argv) {
     cloud = PointCloud{};
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
     switch (packet) {
-        case 1: return run<1>(file, std::move(discs), cam, w, h, all, repeat, quality, leafSize, loadMs);
-        case 16: return run<16>(file, std::move(discs), cam, w, h, all, repeat, quality, leafSize, loadMs);
-        case 256: return run<256>(file, std::move(discs), cam, w, h, all, repeat, quality, leafSize, loadMs);
-        default: return run<64>(file, std::move(discs), cam, w, h, all, repeat, quality, leafSize, loadMs);
+        case 1: return run<1>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+        case 16: return run<16>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+        case 256: return run<256>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+        default: return run<64>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
     }
 }
 

@@ -43,6 +43,10 @@ struct Ctx {
     }
 };
 
+// Radius of the sphere around c that holds the box b: the farthest corner. Often much
+// tighter than covering the children's spheres, whose slack compounds level by level.
+float boxCoverRadius(Vec3f c, const AABB& b) { return length(vmax(b.hi - c, c - b.lo)); }
+
 Disc makeRep(const Agg& a, float radius) {
     Disc r;
     const double iw = a.w > 0 ? 1.0 / a.w : 0.0;
@@ -87,6 +91,7 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         Disc rep = makeRep(a, 0.0f);
         float r = 0;
         for (size_t i = 0; i < n; ++i) r = std::max(r, length(d[i].center - rep.center) + d[i].radius);
+        r = std::min(r, boxCoverRadius(rep.center, a.box));
         rep.radius = r * 1.002f + 1e-7f;  // margin covers the padding of Disc::bounds()
         a.rep = rep;
         return a;
@@ -120,7 +125,8 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
     a.height = std::max(la.height, ra.height) + 1;
     Disc rep = makeRep(a, 0.0f);
     const Disc &lr = la.rep, &rr = ra.rep;
-    const float r = std::max(length(lr.center - rep.center) + lr.radius, length(rr.center - rep.center) + rr.radius);
+    const float r = std::min(std::max(length(lr.center - rep.center) + lr.radius, length(rr.center - rep.center) + rr.radius),
+                             boxCoverRadius(rep.center, a.box));
     rep.radius = r * 1.002f + 1e-7f;  // margin covers the padding of Disc::bounds()
     in.rep = rep;
     quantiseChildBox(in, 0, la.box);

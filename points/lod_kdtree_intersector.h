@@ -20,6 +20,9 @@ struct LoDNodeIntersector {
     const LoDInner* inner = nullptr;
     RayCone cone{};
     float quality = 1.0f;  // 0: full detail
+    // Radius a representative is hit with, relative to its covering radius: the covering
+    // sphere is a loose bound (it puffs silhouettes), the cut test keeps using it.
+    float repScale = 1.0f;
     template <int N>
     using Hit = typename ElemIsect::template Hit<N>;
 
@@ -42,7 +45,9 @@ struct LoDNodeIntersector {
         const Vec3f o(rays.org.x[lane], rays.org.y[lane], rays.org.z[lane]);
         const float dist = std::max(length(r.center - o) - r.radius, 0.0f);
         if (2.0f * r.radius > quality * (cone.base + cone.slope * dist)) return false;
-        elem.template intersect<D>(r, uint32_t(-int32_t(idx) - 2), rays, hit, firstChunk);
+        Disc h = r;
+        h.radius *= repScale;
+        elem.template intersect<D>(h, uint32_t(-int32_t(idx) - 2), rays, hit, firstChunk);
         return true;
     }
 

@@ -35,8 +35,9 @@ struct PointScene {
         tracer.isect.elem.bind(tree);
     }
     // Footprint of the camera rays and the LoD quality (0: full detail).
-    void setLoD(RayCone cone, float quality) {
+    void setLoD(RayCone cone, float quality, float repScale = 1.0f) {
         tracer.isect.elem.bind(tree);
+        tracer.isect.elem.repScale = repScale;
         tracer.isect.elem.cone = cone;
         tracer.isect.elem.quality = quality;
     }

@@ -10,6 +10,8 @@
 //   void childCells(const KdTree<Elem>&, uint32_t node, const AABB& cell, AABB& lo, AABB& hi) const
 // An empty `indices` list means the elements are stored in leaf order (first..first+count).
 #pragma once
+#include <new>
+
 #include "core/accel/kdtree.h"
 #include "core/accel/ray_box.h"
 #include "core/concepts/intersector.h"
@@ -51,9 +53,11 @@ struct KdTreeIntersector {
             AABB cell;
             uint32_t node, first;
         };
-        Entry stack[kStackSize];
+        // Raw storage: AABB's default constructor would fill all 8 KB on every packet.
+        alignas(Entry) unsigned char storage[sizeof(Entry) * kStackSize];
+        Entry* stack = reinterpret_cast<Entry*>(storage);
         int sp = 0;
-        stack[sp++] = {tree.box, 0u, 0u};
+        new (&stack[sp++]) Entry{tree.box, 0u, 0u};
         while (sp > 0) {
             const Entry e = stack[--sp];
             int k = int(e.first);
@@ -89,11 +93,11 @@ struct KdTreeIntersector {
             }
             if (sp + 2 > kStackSize) continue;  // unreachable with the builder's depth limit
             if (rays.dir[axis][k * W] < 0.0f) {
-                stack[sp++] = lo;
-                stack[sp++] = hi;
+                new (&stack[sp++]) Entry(lo);
+                new (&stack[sp++]) Entry(hi);
             } else {
-                stack[sp++] = hi;
-                stack[sp++] = lo;
+                new (&stack[sp++]) Entry(hi);
+                new (&stack[sp++]) Entry(lo);
             }
         }
     }
