@@ -59,7 +59,9 @@ XyzLayout detect(const MappedFile& f) {
         ++lineNo;
         if (vals.empty()) continue;
         if (lineNo == 1 && vals.size() == 1) {
-            if (!(vals[0] >= 0) || vals[0] != std::floor(vals[0])) throw Error(f.name, "bad PTS point count");
+            // Compare as double before converting: a count beyond 2^53 cannot be a real file.
+            if (!(vals[0] >= 0) || vals[0] != std::floor(vals[0]) || vals[0] > 9.0e15)
+                throw Error(f.name, "bad PTS point count");
             L.pts = true;
             L.declared = uint64_t(vals[0]);
             if (L.declared == 0) throw Error(f.name, "empty point cloud (count 0)");

@@ -58,5 +58,44 @@ if [ -n "$("$rtfact" spheres --size 32x32 -o q.png 2>&1 >/dev/null)" ]; then
   echo "FAIL: progress printed although stderr is not a terminal"; fails=$((fails + 1))
 fi
 
+# Hostile inputs through every loader: exit 1, exactly one line naming the file, and no
+# image left behind. (The loaders' own test suites cover many more cases each.)
+hostile() {  # hostile FILE ARGS... : run rtfact ARGS, expect a one-line error about FILE
+  local file="$1"
+  shift
+  rm -f hostile.png
+  local err
+  err=$(timeout 120 "$rtfact" "$@" -o hostile.png --quiet 2>&1 >/dev/null)
+  local rc=$?
+  local lines
+  lines=$(printf '%s\n' "$err" | grep -c .)
+  if [ $rc -ne 1 ] || [ "$lines" -ne 1 ] || [[ "$err" != "rtfact: error: $file: "* ]] || [ -e hostile.png ]; then
+    echo "FAIL: rtfact $* -> exit $rc, $lines line(s): $err"
+    fails=$((fails + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+mkdir -p emptydir
+for ext in ply pcd xyz pts; do : > "empty.$ext"; hostile "empty.$ext" points "empty.$ext"; done
+hostile emptydir points emptydir
+printf '6.66667e+82\n0 0 0\n' > huge.pts        # found by fuzzing (float->int overflow)
+hostile huge.pts points huge.pts
+printf 'ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n' > lying.ply
+hostile lying.ply points lying.ply
+printf 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\nnan 0 0\nnan 1 1\n' > nan.ply
+hostile nan.ply points nan.ply
+for ext in ply obj stl vtk vtp; do : > "mesh.$ext"; hostile "mesh.$ext" mesh "mesh.$ext"; done
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n' > badindex.ply
+hostile badindex.ply mesh badindex.ply
+for ext in mhd nrrd nhdr nii nii.gz vti vdb; do : > "vol.$ext"; hostile "vol.$ext" volume "vol.$ext"; done
+head -c 1000 /dev/zero > vol.raw
+hostile vol.raw volume vol.raw --dims 10,10,11 --type u8
+expect 1 '^rtfact: error: (vol.raw|--dims): .*too large' -- volume vol.raw --dims 100000,100000,100000 --type u16 -o hostile.png
+printf 'ObjectType = Image\nNDims = 3\nDimSize = 0 5 5\nElementType = MET_UCHAR\nElementDataFile = vol.raw\n' > zero.mhd
+hostile zero.mhd volume zero.mhd
+printf '{"colors": [[0, 1, 1]]' > bad.json
+hostile bad.json volume vol.raw --dims 10,10,10 --type u8 --tf bad.json
+
 echo "$passes passed, $fails failed"
 [ $fails -eq 0 ]

@@ -1,0 +1,27 @@
+// libFuzzer harness: our own point-cloud readers (PLY binary/ASCII, XYZ, PTS). The first
+// byte picks the format; the rest is the file.
+#include <cstddef>
+#include <cstdint>
+
+#include "core/util/error.h"
+#include "fuzz/fuzz_file_input.h"
+#include "points/point_cloud_io.h"
+#include "points/point_cloud_io_detail.h"
+
+// PCD goes through PCL, which the harness does not link.
+namespace rtfact::points {
+PointCloud loadPcd(const std::string& file) { throw Error(file, "stub"); }
+std::optional<PointFileInfo> probePcd(const std::string& file) { throw Error(file, "stub"); }
+}  // namespace rtfact::points
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    if (size < 1) return 0;
+    const int kind = data[0] % 3;
+    const std::string path = rtfact::fuzz::writeTemp(data + 1, size - 1, kind == 0 ? ".ply" : kind == 1 ? ".xyz" : ".pts");
+    try {
+        const auto cloud = kind == 0 ? rtfact::points::loadPly(path) : rtfact::points::loadXyz(path);
+        (void)cloud;
+    } catch (const rtfact::Error&) {
+    }
+    return 0;
+}
