@@ -3,6 +3,10 @@
 // hit plus a normal lookup) and one shadow ray per hit towards a point light. Embree
 // runs in its best packet mode for coherent rays: rtcIntersect16/rtcOccluded16 on 4x4
 // pixel blocks with the coherent context flag and a medium-quality build.
+// Secondary rays: AO-style occlusion rays and diffuse-bounce nearest-hit rays from the
+// primary hits in random cosine-weighted directions, traced by RTfact's packet BVH
+// (packets of neighbouring pixels), RTfact's wide BVH one ray at a time, and Embree's
+// rtcOccluded1/rtcIntersect1 (incoherent context), all on the same ray list.
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -12,6 +16,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -21,6 +26,8 @@
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
+#include "core/render/random.h"
+#include "surfaces/ao_integrator.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
 
@@ -47,7 +54,9 @@ struct Frame {
     std::vector<float> t;       // nearest hit distance (inf: miss)
     std::vector<float> shade;   // eyelight value
     std::vector<uint8_t> lit;   // shadow result: 1 = light visible
-    Frame(int w_, int h_) : w(w_), h(h_), t(size_t(w_) * h_), shade(size_t(w_) * h_), lit(size_t(w_) * h_) {}
+    std::vector<int32_t> id;    // triangle hit (-1: miss)
+    Frame(int w_, int h_)
+        : w(w_), h(h_), t(size_t(w_) * h_), shade(size_t(w_) * h_), lit(size_t(w_) * h_), id(size_t(w_) * h_, -1) {}
 };
 
 struct Setup {
@@ -83,18 +92,22 @@ struct RTfactSide {
             py[i] = float(y0 + i / bw) + 0.5f;
         }
     }
-    void primaryTile(Frame& f, int tx, int ty) const {
+    // wide: the packet's rays go one by one through the wide BVH (far views with
+    // sub-pixel triangles, where packets no longer share nodes).
+    void primaryTile(Frame& f, int tx, int ty, bool wide = false) const {
         for (int y = ty; y < std::min(ty + kTile, f.h); y += bh)
             for (int x = tx; x < std::min(tx + kTile, f.w); x += bw) {
                 Packet<N> px, py;
                 pixels(x, y, px, py);
                 RayPacket<N> rays;
                 s.cam.template generate<N>(px, py, rays);
-                const auto hit = scene.template intersect<N>(rays, Mask<N>(true));
+                const auto hit = wide ? scene.template intersectIncoherent<N>(rays, Mask<N>(true))
+                                      : scene.template intersect<N>(rays, Mask<N>(true));
                 for (int i = 0; i < N; ++i) {
                     const size_t pix = size_t(y + i / bw) * f.w + size_t(x + i % bw);
                     const int id = hit.id[i];
                     f.t[pix] = id >= 0 ? hit.t[i] : kInfinity;
+                    f.id[pix] = id;
                     f.shade[pix] = id >= 0 ? std::fabs(dot(s.triNormal[size_t(id)], rays.dir.lane(i))) : 0.0f;
                 }
             }
@@ -128,6 +141,89 @@ struct RTfactSide {
             }
     }
 };
+
+// ---- Secondary rays ----------------------------------------------------------------------
+
+// Random cosine-weighted rays from the primary hits, `samples` per hit, grouped so that
+// consecutive rays of one packet start at neighbouring pixels (as in the AO integrator).
+struct SecondaryRays {
+    std::vector<Vec3f> org, dir;
+    float tMaxAO = kInfinity;
+    size_t size() const { return org.size(); }
+};
+
+SecondaryRays makeSecondary(const Frame& base, const Setup& s, const AABB& box, int samples, int group) {
+    SecondaryRays r;
+    const float diag = std::max(length(box.extent()), 1e-6f);
+    r.tMaxAO = 0.2f * diag;
+    std::vector<size_t> hitPix;
+    for (size_t i = 0; i < base.t.size(); ++i)
+        if (base.id[i] >= 0) hitPix.push_back(i);
+    for (size_t g = 0; g < hitPix.size(); g += size_t(group))
+        for (int smp = 0; smp < samples; ++smp)
+            for (size_t j = g; j < std::min(g + size_t(group), hitPix.size()); ++j) {
+                const size_t pix = hitPix[j];
+                const int px = int(pix % size_t(base.w)), py = int(pix / size_t(base.w));
+                RayPacket<1> cam;
+                s.cam.template generate<1>(Packet<1>(float(px) + 0.5f), Packet<1>(float(py) + 0.5f), cam);
+                const Vec3f d0 = cam.dir.lane(0);
+                Vec3f n = s.triNormal[size_t(base.id[pix])];
+                if (dot(n, d0) > 0.0f) n = -n;
+                const Vec3<1> dir = cosineHemisphere(Vec3<1>(n), hashToUnit<1>(px, py, uint32_t(smp), 0),
+                                                     hashToUnit<1>(px, py, uint32_t(smp), 1));
+                r.org.push_back(cam.org.lane(0) + d0 * base.t[pix] + n * (1e-4f * diag));
+                r.dir.push_back(normalize(dir.lane(0)));
+            }
+    return r;
+}
+
+template <class F>
+double timeRange(int threads, size_t n, size_t grain, F&& f) {
+    tbb::task_arena arena(threads);
+    const auto t0 = Clock::now();
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); });
+    });
+    return msSince(t0);
+}
+
+// RTfact on the secondary ray list: packets of N through the packet BVH, or single rays
+// through the wide BVH. Results go to occ (AO) / t (bounce) for the agreement check.
+template <int N>
+void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr, size_t b, size_t e, bool wide, bool ao,
+                 std::vector<float>& out) {
+    if (wide) {
+        for (size_t i = b; i < e; ++i) {
+            RayPacket<1> r;
+            r.setLane(0, sr.org[i], sr.dir[i], 0.0f, ao ? sr.tMaxAO : kInfinity);
+            r.finalize();
+            if (ao) {
+                out[i] = scene.occludedIncoherent<1>(r, Mask<1>(true))[0] ? 1.0f : 0.0f;
+            } else {
+                const auto h = scene.intersectIncoherent<1>(r, Mask<1>(true));
+                out[i] = int32_t(h.id) >= 0 ? float(h.t) : kInfinity;
+            }
+        }
+        return;
+    }
+    for (size_t p = b; p < e; p += N) {
+        RayPacket<N> r;
+        Mask<N> active(true);
+        for (int i = 0; i < N; ++i) {
+            const size_t k = p + size_t(i);
+            if (k < e) r.setLane(i, sr.org[k], sr.dir[k], 0.0f, ao ? sr.tMaxAO : kInfinity);
+            else r.setLane(i, sr.org[b], sr.dir[b], 0.0f, 0.0f), active.set(i, false);
+        }
+        r.finalize();
+        if (ao) {
+            const Mask<N> occ = scene.template occluded<N>(r, active);
+            for (int i = 0; i < N && p + size_t(i) < e; ++i) out[p + size_t(i)] = occ[i] ? 1.0f : 0.0f;
+        } else {
+            const auto h = scene.template intersect<N>(r, active);
+            for (int i = 0; i < N && p + size_t(i) < e; ++i) out[p + size_t(i)] = h.id[i] >= 0 ? h.t[i] : kInfinity;
+        }
+    }
+}
 
 // ---- Embree -----------------------------------------------------------------------------
 
@@ -264,6 +360,35 @@ struct EmbreeSide {
     }
 };
 
+void embreeSecondary(RTCScene scene, const SecondaryRays& sr, size_t b, size_t e, bool ao, std::vector<float>& out) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    for (size_t i = b; i < e; ++i) {
+        RTCRayHit rh;
+        rh.ray.org_x = sr.org[i].x;
+        rh.ray.org_y = sr.org[i].y;
+        rh.ray.org_z = sr.org[i].z;
+        rh.ray.dir_x = sr.dir[i].x;
+        rh.ray.dir_y = sr.dir[i].y;
+        rh.ray.dir_z = sr.dir[i].z;
+        rh.ray.tnear = 0.0f;
+        rh.ray.tfar = ao ? sr.tMaxAO : kInfinity;
+        rh.ray.time = 0.0f;
+        rh.ray.mask = ~0u;
+        rh.ray.flags = 0;
+        rh.ray.id = 0;
+        if (ao) {
+            rtcOccluded1(scene, &ctx, &rh.ray);
+            out[i] = rh.ray.tfar < 0.0f ? 1.0f : 0.0f;
+        } else {
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(scene, &ctx, &rh);
+            out[i] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh.ray.tfar : kInfinity;
+        }
+    }
+}
+
 struct Result {
     double ms = 1e30;
     uint64_t rays = 0;
@@ -275,7 +400,8 @@ uint64_t countHits(const Frame& f) {
 }
 
 template <int N>
-int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat) {
+int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat,
+        int secSamples) {
     std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w, h,
                 N, allThreads);
     auto meshPtr = std::make_shared<const Mesh>(mesh);
@@ -326,6 +452,55 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
         worstPrimary = std::min(worstPrimary, rp.mrays() / ep.mrays());
         worstShadow = std::min(worstShadow, rs.mrays() / esBest.mrays());
     }
+    // Far views with sub-pixel triangles: the same primary rays one by one through the
+    // wide BVH (not part of the ratios above).
+    for (int T : threadCounts) {
+        Result rw, rp;
+        Frame fw(w, h);
+        for (int r = 0; r < repeat; ++r) {
+            rp.ms = std::min(rp.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fw, x, y, false); }));
+            rw.ms = std::min(rw.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fw, x, y, true); }));
+        }
+        rw.rays = rp.rays = uint64_t(w) * h;
+        std::printf("threads=%d primary_mrays: rtfact_packet=%.2f rtfact_wide_single=%.2f ratio_wide_vs_packet=%.3f\n", T,
+                    rp.mrays(), rw.mrays(), rw.mrays() / rp.mrays());
+    }
+    // Secondary rays (incoherent): the same list for every tracer.
+    if (secSamples > 0) {
+        const SecondaryRays sr = makeSecondary(base, setup, scene.bounds(), secSamples, N);
+        std::printf("secondary_rays=%zu (%d per primary hit, AO length %.4g)\n", sr.size(), secSamples, sr.tMaxAO);
+        std::vector<float> outP(sr.size()), outW(sr.size()), outE(sr.size());
+        for (int ao = 1; ao >= 0; --ao) {
+            const char* name = ao ? "ao_occluded" : "bounce_nearest";
+            for (int T : threadCounts) {
+                Result p, wd, e;
+                for (int r = 0; r < repeat; ++r) {
+                    p.ms = std::min(p.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
+                        rtSecondary<N>(scene, sr, b, en, false, ao, outP);
+                    }));
+                    wd.ms = std::min(wd.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
+                        rtSecondary<N>(scene, sr, b, en, true, ao, outW);
+                    }));
+                    e.ms = std::min(e.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
+                        embreeSecondary(em->scene, sr, b, en, ao, outE);
+                    }));
+                }
+                p.rays = wd.rays = e.rays = sr.size();
+                std::printf("threads=%d %s_mrays: rtfact_wide_single=%.2f rtfact_packet%d=%.2f embree_single=%.2f "
+                            "ratio_wide_vs_embree=%.3f ratio_wide_vs_packet=%.3f\n",
+                            T, name, wd.mrays(), N, p.mrays(), e.mrays(), wd.mrays() / e.mrays(), wd.mrays() / p.mrays());
+            }
+            size_t diffPW = 0, diffWE = 0;
+            for (size_t i = 0; i < sr.size(); ++i) {
+                const auto same = [&](float a, float b) {
+                    return ao ? a == b : (std::isinf(a) == std::isinf(b) && (std::isinf(a) || std::fabs(a - b) <= 1e-3f * std::max(1.0f, a)));
+                };
+                diffPW += !same(outP[i], outW[i]);
+                diffWE += !same(outW[i], outE[i]);
+            }
+            std::printf("agreement_%s: packet_vs_wide_diff=%zu wide_vs_embree_diff=%zu\n", name, diffPW, diffWE);
+        }
+    }
     // Agreement of the two tracers (a sanity check, not a timing).
     size_t hitDiff = 0, rtOnlyShadow = 0, emOnlyShadow = 0;
     for (size_t i = 0; i < fr.t.size(); ++i) {
@@ -350,7 +525,7 @@ int benchMesh(int argc, char** argv) {
     CLI::App app{"RTfact vs Embree on a mesh: BVH build, primary and shadow rays", "rtfact-bench mesh"};
     std::string file, eye, at, up, size = "1024x1024";
     float fov = 45.0f;
-    int threads = 0, packet = 256, repeat = 3, grid = 1;
+    int threads = 0, packet = 256, repeat = 3, grid = 1, secondary = 4;
     app.add_option("FILE", file, "Mesh file")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
     app.add_option("--at", at, "Camera target x,y,z");
@@ -362,6 +537,9 @@ int benchMesh(int argc, char** argv) {
     app.add_option("--grid", grid, "Many occluders: a GxG grid of copies of the mesh on a ground plane")
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
+    app.add_option("--secondary", secondary, "Secondary (AO and bounce) rays per primary hit; 0: skip")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 64));
     app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")->capture_default_str()->check(CLI::Range(1, 100));
     try {
         app.parse(argc, argv);
@@ -410,9 +588,9 @@ int benchMesh(int argc, char** argv) {
         setup.triNormal[i] = normalize(cross(b - a, c - a));
     }
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat);
-    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat);
-    return run<256>(file, mesh, setup, w, h, all, repeat);
+    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat, secondary);
+    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat, secondary);
+    return run<256>(file, mesh, setup, w, h, all, repeat, secondary);
 }
 
 }  // namespace rtfact::bench
