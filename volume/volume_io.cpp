@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/memory_budget.h"
 #include "core/util/progress.h"
 
 namespace fs = std::filesystem;
@@ -190,6 +191,9 @@ void decodePayload(VolumeGrid& g, Src src, bool bigEndian, std::vector<Piece>& p
     if (total != n * uint64_t(sb)) throw Error(header, "data pieces hold " + std::to_string(total) + " bytes, expected " + std::to_string(n * uint64_t(sb)));
     checkPieces(header, pieces);
     g.sourceType = srcName(src);
+    // The dense grid plus its bricked copy for rendering.
+    checkMemory(header, n * uint64_t(storageBytes(storageFor(src))) * 2, "the volume",
+                "a sparse OpenVDB grid renders without densifying");
     g.allocate(storageFor(src));
     const bool swap = bigEndian && sb > 1;
     std::vector<uint8_t> buf(size_t(1) << 20);
