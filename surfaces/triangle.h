@@ -10,7 +10,10 @@
 // a light) the edge vectors are scalar per triangle and each chunk only needs four dot
 // products (three edges and the plane).
 #pragma once
+#include <algorithm>
+
 #include "core/concepts/intersector.h"
+#include "core/simd/bitmask.h"
 
 namespace rtfact {
 
@@ -86,6 +89,49 @@ struct TriangleIntersector {
                 const Vec3<W> a = v0 - o, b = v1 - o, c = v2 - o;
                 finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d), dot(nn, a),
                        dot(nn, d));
+            }
+        }
+    }
+
+    // A whole leaf against one ray (the wide BVH's single-ray path): the triangles of
+    // the leaf fill the SIMD lanes, kLeafLanes at a time, with the same edge functions.
+    static constexpr int kLeafLanes = 8;
+    template <HitData D>
+    RTFACT_INLINE void intersectLeaf(const Triangle* tris, const uint32_t* ids, int count, const RayPacket<1>& ray,
+                                     Hit<1>& hit) const {
+        constexpr int L = kLeafLanes;
+        using P = Packet<L>;
+        const Vec3f of(ray.org.x[0], ray.org.y[0], ray.org.z[0]);
+        const Vec3<L> d(Vec3f(ray.dir.x[0], ray.dir.y[0], ray.dir.z[0]));
+        const P zero(0.0f), inf(kInfinity);
+        for (int base = 0; base < count; base += L) {
+            const int n = std::min(L, count - base);
+            Vec3<L> a, b, c;
+            for (int i = 0; i < L; ++i) {
+                const Triangle& t = tris[base + std::min(i, n - 1)];  // pad with the last one
+                a.setLane(i, t.v0 - of);
+                b.setLane(i, t.v1 - of);
+                c.setLane(i, t.v2 - of);
+            }
+            // Same values as the per-triangle test: n = (v1 - v0) x (v2 - v0).
+            const Vec3<L> nn = cross(b - a, c - a);
+            const P e0 = dot(triangleEdge(b, c), d), e1 = dot(triangleEdge(c, a), d), e2 = dot(triangleEdge(a, b), d);
+            const P nd = dot(nn, d);
+            const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
+            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != zero);
+            if (none(inside)) continue;
+            const P t = dot(nn, a) / nd;
+            const auto m = inside & (t > P(float(ray.tMin))) & (t < P(float(hit.t)));
+            if (none(m)) continue;
+            const P tm = select(m, t, inf);
+            const float best = hmin(tm);
+            const int lane = BitMask<L>(tm == P(best)).first();
+            hit.t = best;
+            hit.id = int32_t(ids[base + lane]);
+            if constexpr (D == HitData::Shading) {
+                const float inv = 1.0f / (e0[lane] + e1[lane] + e2[lane]);
+                hit.u = e1[lane] * inv;
+                hit.v = e2[lane] * inv;
             }
         }
     }

@@ -133,9 +133,17 @@ struct WideBVHIntersector {
                     node = e.child;
                     break;
                 }
-                for (int i = 0; i < e.count; ++i) {
-                    const uint32_t ei = uint32_t(e.child + i);
-                    elem.template intersect<D>(bvh.elems[ei], bvh.order[ei], ray, hit, 0);
+                // Element intersectors may test a whole leaf at once (SIMD over elements).
+                if constexpr (requires {
+                                  elem.template intersectLeaf<D>(bvh.elems.data(), bvh.order.data(), 1, ray, hit);
+                              }) {
+                    elem.template intersectLeaf<D>(bvh.elems.data() + e.child, bvh.order.data() + e.child, e.count, ray,
+                                                   hit);
+                } else {
+                    for (int i = 0; i < e.count; ++i) {
+                        const uint32_t ei = uint32_t(e.child + i);
+                        elem.template intersect<D>(bvh.elems[ei], bvh.order[ei], ray, hit, 0);
+                    }
                 }
                 if constexpr (AnyHit) {
                     if (int32_t(hit.id) >= 0) return;
