@@ -50,8 +50,8 @@ struct Disc {
     Vec3f n() const { return decodeNormal(normal); }
     uint8_t level() const { return uint8_t(rgba >> 24); }
     // Tight box of a disc: along axis a it reaches r * sqrt(1 - n_a^2).
-    AABB bounds() const {
-        const Vec3f nn = n();
+    AABB bounds() const { return bounds(center, radius, n()); }
+    static AABB bounds(Vec3f center, float radius, Vec3f nn) {
         const Vec3f e(radius * std::sqrt(std::max(0.0f, 1.0f - nn.x * nn.x)),
                       radius * std::sqrt(std::max(0.0f, 1.0f - nn.y * nn.y)),
                       radius * std::sqrt(std::max(0.0f, 1.0f - nn.z * nn.z)));

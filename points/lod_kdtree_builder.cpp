@@ -78,14 +78,14 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         t.nodes[slot] = KdNode::leaf(uint32_t(d - ctx.base), uint32_t(n));
         for (size_t i = 0; i < n; ++i) {
             const double w = double(d[i].radius) * d[i].radius + 1e-30;
-            const Vec3f nn = d[i].n(), col = unpackRGB(d[i].rgba);
+            const Vec3f nn = d[i].n(), col = unpackRGB(d[i].rgba);  // decoded once: bounds from nn below
             for (int k = 0; k < 3; ++k) {
                 a.c[k] += w * d[i].center[k];
                 a.n[k] += w * nn[k];
                 a.col[k] += w * col[k];
             }
             a.w += w;
-            a.box.extend(d[i].bounds());
+            a.box.extend(Disc::bounds(d[i].center, d[i].radius, nn));
         }
         a.height = 1;
         Disc rep = makeRep(a, 0.0f);

@@ -22,7 +22,7 @@ struct LoDNodeIntersector {
     float quality = 1.0f;  // 0: full detail
     // Radius a representative is hit with, relative to its covering radius: the covering
     // sphere is a loose bound (it puffs silhouettes), the cut test keeps using it.
-    float repScale = 1.0f;
+    float repScale = 0.7f;  // dragon 32M, quality 4: +2.3 dB PSNR vs 1.0; 0.55 opens holes
     template <int N>
     using Hit = typename ElemIsect::template Hit<N>;
 

@@ -35,7 +35,7 @@ struct PointScene {
         tracer.isect.elem.bind(tree);
     }
     // Footprint of the camera rays and the LoD quality (0: full detail).
-    void setLoD(RayCone cone, float quality, float repScale = 1.0f) {
+    void setLoD(RayCone cone, float quality, float repScale = 0.7f) {
         tracer.isect.elem.bind(tree);
         tracer.isect.elem.repScale = repScale;
         tracer.isect.elem.cone = cone;

@@ -83,6 +83,8 @@ struct KdTreeIntersector {
             if constexpr (requires { elem.template innerNode<D>(tree, e.node, e.cell, rays, hit, k); }) {
                 if (elem.template innerNode<D>(tree, e.node, e.cell, rays, hit, k)) continue;
             }
+            // The near child is popped next: start loading the children's pair now.
+            __builtin_prefetch(&tree.nodes[node.left()]);
             const int axis = node.axis();
             Entry lo{e.cell, node.left(), uint32_t(k)}, hi{e.cell, node.left() + 1, uint32_t(k)};
             if constexpr (requires { elem.childCells(tree, e.node, e.cell, lo.cell, hi.cell); }) {
