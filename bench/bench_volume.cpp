@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "bench/bench_commands.h"
+#include "bench/bench_common.h"
 #include "core/render/framebuffer.h"
 #include "core/render/image_io.h"
 #include "core/render/packet_dispatch.h"
@@ -38,14 +39,6 @@ namespace rtfact::bench {
 namespace {
 
 using namespace rtfact::volume;
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-Vec3f parseV(const std::string& s, const char* opt) {
-    Vec3f v;
-    if (std::sscanf(s.c_str(), "%f,%f,%f", &v.x, &v.y, &v.z) != 3) throw Error("", std::string(opt) + ": expected x,y,z, got '" + s + "'");
-    return v;
-}
 
 // The peer: OpenVDB intersector + BoxSampler, front-to-back with our TF table.
 struct VdbMarcher {
@@ -171,9 +164,9 @@ int benchVolume(int argc, char** argv) {
     const double buildMs = msSince(t0);
     const AABB box = vol.bounds();
     CameraFrame frame = fitCamera(box, fov, float(w) / float(h), {0.45f, -1.0f, 0.35f}, {0, 0, 1});
-    if (!eye.empty()) frame.eye = parseV(eye, "--eye");
-    if (!at.empty()) frame.at = parseV(at, "--at");
-    if (!up.empty()) frame.up = parseV(up, "--up");
+    if (!eye.empty()) frame.eye = parseVec(eye, "--eye");
+    if (!at.empty()) frame.at = parseVec(at, "--at");
+    if (!up.empty()) frame.up = parseVec(up, "--up");
     const PinholeCamera cam(frame, w, h);
     const int allThreads = resolveThreads(threads);
     std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, bricks+TF %.0f ms\n", file.c_str(),
