@@ -2,8 +2,7 @@
 // the scene's lights plus a small ambient term. All shadow rays of a packet towards
 // one light travel together as a packet.
 #pragma once
-#include "core/concepts/integrator.h"
-#include "core/concepts/scene.h"
+#include "core/render/primary_hit.h"
 #include "core/render/light_list.h"
 
 namespace rtfact {
@@ -16,14 +15,10 @@ struct DirectLightIntegrator {
 
     template <int N, class Scene>
     Radiance<N> eval(const Scene& scene, RayPacket<N>& rays, const Mask<N>& active, const PixelSample<N>&) const {
-        const auto hit = scene.template intersect<N>(rays, active);
-        const Mask<N> found = active & (hit.id != Packet<N, int32_t>(-1));
-        Radiance<N> r;
-        r.color = Vec3<N>(background);
-        r.alpha = Packet<N>(0.0f);
-        r.depth = select(found, hit.t, Packet<N>(kInfinity));
-        if (none(found)) return r;
-        const SurfacePoint<N> sp = scene.template surface<N>(rays, hit, found);
+        PrimaryHit<N, Scene> ph;
+        if (!tracePrimary(scene, rays, active, background, ph)) return ph.result;
+        const SurfacePoint<N>& sp = ph.sp;
+        const Mask<N>& found = ph.found;
         const AABB b = scene.bounds();
         const float eps = 1e-4f * std::max(length(b.extent()), 1e-6f);
         Vec3<N> sum = sp.color * Packet<N>(ambient);
@@ -49,15 +44,13 @@ struct DirectLightIntegrator {
             // Headlight: light from the viewer never casts visible shadows.
             LightSample<N> ls;
             ls.wi = -rays.dir;
-            ls.distance = hit.t;
+            ls.distance = ph.hit.t;
             ls.radiance = Vec3<N>(Vec3f(3.14159265f));
             shade(ls, false);
         } else {
             for (const AnyLight& l : lights) shade(sampleLight<N>(l, sp.p, zero, zero), shadows);
         }
-        r.color = select(found, sum, r.color);
-        r.alpha = select(found, Packet<N>(1.0f), r.alpha);
-        return r;
+        return ph.finish(sum);
     }
 };
 
