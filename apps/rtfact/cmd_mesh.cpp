@@ -30,6 +30,7 @@ struct MeshOpts {
     std::string material;
     std::string bvh = "sah";
     int aoSamples = 16;
+    std::string secondary = "auto";  // traversal of AO / bounce rays: auto | wide | packet
     int maxDepth = 6;
 };
 
@@ -82,11 +83,37 @@ void applyMaterial(Mesh& m, const std::string& spec) {
     m.colors.clear();
 }
 
+template <class Secondary, class Scene>
+void renderSecondary(const MeshOpts& o, const Scene& scene, const Mesh& mesh, const CameraFrame& frame, Stats& stats) {
+    const CommonOptions& c = o.common;
+    if (o.integrator == "path") {
+        PathIntegratorT<Secondary> pt;
+        pt.maxDepth = o.maxDepth;
+        pt.materials = PathIntegrator::fromMesh(mesh);
+        // Without emitters (MTL Ke) the scene is lit by a bright sky.
+        const bool emitters = std::any_of(pt.materials.begin(), pt.materials.end(),
+                                          [](const PathMaterial& m) { return maxComponent(m.emission) > 0.0f; });
+        if (!emitters) pt.background = Vec3f(0.9f, 0.95f, 1.0f);
+        renderToFile(scene, pt, c, frame, stats);
+    } else {
+        AOIntegratorT<Secondary> ao;
+        ao.samples = o.aoSamples;
+        renderToFile(scene, ao, c, frame, stats);
+    }
+}
+
 template <class Structure>
 int renderMesh(const MeshOpts& o, std::shared_ptr<const Mesh> mesh, Stats& stats) {
     const CommonOptions& c = o.common;
     const auto t0 = std::chrono::steady_clock::now();
-    MeshScene<Structure> scene(mesh);
+    // Only integrators with incoherent rays need the wide BVH.
+    const bool incoherent = o.integrator == "path" || o.integrator == "ao";
+    // auto: the integrator's own default (AO: packets, path bounces: wide single rays).
+    const std::string secondary = o.secondary != "auto" ? o.secondary : o.integrator == "path" ? "wide" : "packet";
+    MeshScene<Structure> scene;
+    scene.mesh = mesh;
+    scene.buildWide = incoherent && secondary == "wide";
+    scene.build();
     stats.add("build_ms", msSince(t0));
     stats.add("triangles", (unsigned long long)mesh->triangles());
     stats.add("bvh_bytes", (unsigned long long)scene.memoryBytes());
@@ -94,19 +121,10 @@ int renderMesh(const MeshOpts& o, std::shared_ptr<const Mesh> mesh, Stats& stats
     const CameraFrame frame = c.frame(box);
     if (o.integrator == "eyelight") {
         renderToFile(scene, EyeLightIntegrator{}, c, frame, stats);
-    } else if (o.integrator == "path") {
-        PathIntegrator pt;
-        pt.maxDepth = o.maxDepth;
-        pt.materials = PathIntegrator::fromMesh(*mesh);
-        // Without emitters (MTL Ke) the scene is lit by a bright sky.
-        const bool emitters = std::any_of(pt.materials.begin(), pt.materials.end(),
-                                          [](const PathMaterial& m) { return maxComponent(m.emission) > 0.0f; });
-        if (!emitters) pt.background = Vec3f(0.9f, 0.95f, 1.0f);
-        renderToFile(scene, pt, c, frame, stats);
-    } else if (o.integrator == "ao") {
-        AOIntegrator ao;
-        ao.samples = o.aoSamples;
-        renderToFile(scene, ao, c, frame, stats);
+    } else if (incoherent) {
+        stats.add("secondary", secondary);
+        if (secondary == "wide") renderSecondary<WideSecondaryRays>(o, scene, *mesh, frame, stats);
+        else renderSecondary<PacketSecondaryRays>(o, scene, *mesh, frame, stats);
     } else {
         LightList lights;
         for (const std::string& l : o.lights) lights.push_back(parseLight(l, box));
@@ -149,6 +167,11 @@ void addMeshCommand(CLI::App& app, CommandList& list) {
         ->capture_default_str()
         ->check(CLI::IsMember({"sah", "kdtree"}));
     cmd->add_option("--ao-samples", o->aoSamples, "Ambient occlusion rays per hit")->capture_default_str()->check(CLI::Range(1, 1024));
+    cmd->add_option("--secondary", o->secondary,
+                    "AO / path bounce rays: wide (single rays through a wide BVH), packet (the packet BVH) or auto "
+                    "(AO: packet, path: wide)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "wide", "packet"}));
     list.push_back({cmd, [o] {
                         CommonOptions& c = o->common;
                         c.finalize();
