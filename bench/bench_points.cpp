@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "bench/bench_commands.h"
+#include "bench/bench_common.h"
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
@@ -33,19 +34,6 @@ namespace rtfact::bench {
 namespace {
 
 using namespace rtfact::points;
-using Clock = std::chrono::steady_clock;
-double msSinceP(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-Vec3f parseVec(const std::string& s, const char* opt) {
-    Vec3f v;
-    char c1 = 0, c2 = 0;
-    std::istringstream in(s);
-    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',')
-        throw Error("", std::string(opt) + ": expected x,y,z, got '" + s + "'");
-    return v;
-}
-
-constexpr int kTile = 32;
 
 struct Frame {
     int w, h;
@@ -53,19 +41,6 @@ struct Frame {
     std::vector<uint8_t> hit;
     Frame(int w_, int h_) : w(w_), h(h_), shade(size_t(w_) * size_t(h_)), hit(size_t(w_) * size_t(h_)) {}
 };
-
-template <class F>
-double timeTiles(int threads, int w, int h, F&& tile) {
-    const int tx = (w + kTile - 1) / kTile, ty = (h + kTile - 1) / kTile;
-    tbb::task_arena arena(threads);
-    const auto t0 = Clock::now();
-    arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, tx * ty, 1), [&](const tbb::blocked_range<int>& r) {
-            for (int i = r.begin(); i != r.end(); ++i) tile((i % tx) * kTile, (i / tx) * kTile);
-        });
-    });
-    return msSinceP(t0);
-}
 
 float luminance(uint32_t rgba) {
     const Vec3f c = unpackRGB(rgba);
@@ -147,7 +122,7 @@ struct EmbreeSide {
         rtcReleaseGeometry(g);
         const auto t0 = Clock::now();
         rtcCommitScene(scene);
-        return msSinceP(t0);
+        return msSince(t0);
     }
 
     void tile(Frame& f, int tx, int ty) const {
@@ -227,7 +202,7 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
             std::copy(discs.begin(), discs.end(), copy.begin());
             const auto t0 = Clock::now();
             arena.execute([&] { scene.build(std::move(copy), builder); });
-            rtBuild = std::min(rtBuild, msSinceP(t0));
+            rtBuild = std::min(rtBuild, msSince(t0));
         }
     }
     // Embree gets the same discs in the same (leaf) order.
@@ -326,7 +301,7 @@ int benchPoints(int argc, char** argv) {
     setProgressEnabled(false);
     const auto t0 = Clock::now();
     PointCloud cloud = loadPointCloud(file);
-    const double loadMs = msSinceP(t0);
+    const double loadMs = msSince(t0);
     CameraFrame frame = fitCamera(cloud.bounds(), fov, float(w) / float(h));
     if (!eye.empty()) frame.eye = parseVec(eye, "--eye");
     if (!at.empty()) frame.at = parseVec(at, "--at");
