@@ -27,7 +27,7 @@
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
 #include "core/render/random.h"
-#include "surfaces/ao_integrator.h"
+#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
 

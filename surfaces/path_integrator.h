@@ -12,9 +12,9 @@
 #include "core/concepts/integrator.h"
 #include "core/concepts/scene.h"
 #include "core/render/random.h"
-#include "surfaces/ao_integrator.h"
+#include "core/render/sampling.h"
 #include "surfaces/mesh.h"
-#include "surfaces/secondary_rays.h"
+#include "core/render/secondary_rays.h"
 
 namespace rtfact {
 

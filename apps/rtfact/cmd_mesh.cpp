@@ -12,7 +12,7 @@
 #include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
 #include "core/util/error.h"
-#include "surfaces/ao_integrator.h"
+#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/path_integrator.h"

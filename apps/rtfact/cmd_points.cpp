@@ -9,7 +9,7 @@
 #include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
 #include "core/util/error.h"
-#include "points/ao_integrator.h"
+#include "core/render/ao_integrator.h"
 #include "points/point_cloud_io.h"
 #include "points/point_generator.h"
 #include "points/point_scene.h"
@@ -99,6 +99,9 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
                         } else if (o->integrator == "ao") {
                             AOIntegrator ao;
                             ao.samples = o->aoSamples;
+                            // Splats overlap their neighbours: start AO rays clear of the local surface.
+                            ao.offset = 4e-3f;
+                            ao.minDistance = 4e-3f;
                             renderToFile(scene, ao, c, frame, stats);
                         } else {
                             DirectLightIntegrator integ;

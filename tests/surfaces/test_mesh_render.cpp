@@ -13,7 +13,7 @@
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/render/tile_scheduler.h"
-#include "surfaces/ao_integrator.h"
+#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/whitted_integrator.h"
 #include "test_meshes.h"

@@ -14,7 +14,7 @@
 #include "core/render/tile_scheduler.h"
 #include "core/accel/wide_bvh_intersector.h"
 #include "core/geometry/sphere.h"
-#include "surfaces/ao_integrator.h"
+#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/path_integrator.h"
 #include "test_meshes.h"
