@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "bench/bench_commands.h"
+#include "bench/bench_common.h"
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
@@ -33,20 +34,6 @@
 
 namespace rtfact::bench {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-Vec3f parseV(const std::string& s, const char* opt) {
-    Vec3f v;
-    char c1 = 0, c2 = 0;
-    std::istringstream in(s);
-    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',')
-        throw Error("", std::string(opt) + ": expected x,y,z, got '" + s + "'");
-    return v;
-}
-
-constexpr int kTile = 32;
 
 // What both tracers produce per pixel, so their results can be compared.
 struct Frame {
@@ -65,18 +52,6 @@ struct Setup {
     std::vector<Vec3f> triNormal;  // unit geometric normal per input triangle
 };
 
-template <class F>
-double timeTiles(int threads, int w, int h, F&& tile) {
-    const int tx = (w + kTile - 1) / kTile, ty = (h + kTile - 1) / kTile;
-    tbb::task_arena arena(threads);
-    const auto t0 = Clock::now();
-    arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, tx * ty, 1), [&](const tbb::blocked_range<int>& r) {
-            for (int i = r.begin(); i != r.end(); ++i) tile((i % tx) * kTile, (i / tx) * kTile);
-        });
-    });
-    return msSince(t0);
-}
 
 // ---- RTfact ---------------------------------------------------------------------------
 
@@ -573,9 +548,9 @@ int benchMesh(int argc, char** argv) {
     Setup setup;
     const AABB box = mesh.bounds();
     CameraFrame frame = fitCamera(box, fov, float(w) / float(h));
-    if (!eye.empty()) frame.eye = parseV(eye, "--eye");
-    if (!at.empty()) frame.at = parseV(at, "--at");
-    if (!up.empty()) frame.up = parseV(up, "--up");
+    if (!eye.empty()) frame.eye = parseVec(eye, "--eye");
+    if (!at.empty()) frame.at = parseVec(at, "--at");
+    if (!up.empty()) frame.up = parseVec(up, "--up");
     frame.fovDeg = fov;
     setup.cam = PinholeCamera(frame, w, h);
     // The light sits above and beside the camera, so shadows fall visibly.
