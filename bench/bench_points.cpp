@@ -22,6 +22,7 @@
 
 #include "bench/bench_commands.h"
 #include "bench/bench_common.h"
+#include "bench/bench_embree.h"
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
@@ -141,20 +142,7 @@ struct EmbreeSide {
                 RayPacket<16> rays;
                 cam.generate<16>(px, py, rays);
                 alignas(64) RTCRayHit16 rh;
-                for (int i = 0; i < 16; ++i) {
-                    rh.ray.org_x[i] = rays.org.x[i];
-                    rh.ray.org_y[i] = rays.org.y[i];
-                    rh.ray.org_z[i] = rays.org.z[i];
-                    rh.ray.dir_x[i] = rays.dir.x[i];
-                    rh.ray.dir_y[i] = rays.dir.y[i];
-                    rh.ray.dir_z[i] = rays.dir.z[i];
-                    rh.ray.tnear[i] = 0.0f;
-                    rh.ray.tfar[i] = kInfinity;
-                    rh.ray.time[i] = 0.0f;
-                    rh.ray.mask[i] = ~0u;
-                    rh.ray.flags[i] = 0;
-                    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                }
+                toEmbree(rays, rh);
                 rtcIntersect16(valid, scene, &ctx, &rh);
                 for (int i = 0; i < 16; ++i) {
                     const size_t pix = size_t(y + i / 4) * size_t(f.w) + size_t(x + i % 4);
