@@ -51,7 +51,10 @@ struct Outcome {
 Outcome hammer(const std::string& source, const std::string& ext, const std::function<void(const std::string&)>& load) {
     const std::string bytes = readAll(source);
     EXPECT_FALSE(bytes.empty()) << source;
-    const std::string path = outDir() + "/hostile" + ext;
+    // One file per test: ctest runs the tests in parallel processes, and truncating a file
+    // another process has memory-mapped would kill that process with SIGBUS.
+    const std::string path =
+        outDir() + "/" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + ext;
     Outcome o;
     auto attempt = [&](const std::string& variant, const std::string& what) {
         writeAll(path, variant);
