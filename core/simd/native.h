@@ -184,7 +184,7 @@ RTFACT_INLINE V vmin(V a, V b) {
         using E = std::remove_cvref_t<decltype(a[0])>;
         if constexpr (std::is_same_v<E, float>) {
 #if RTFACT_NATIVE_WIDTH >= 16
-            if constexpr (W == 16) return _mm512_min_ps(a, b);
+            if constexpr (W == 16) return _mm512_maskz_min_ps(__mmask16(0xFFFF), a, b);  // maskz: no undefined source
 #endif
 #if RTFACT_NATIVE_WIDTH >= 8
             if constexpr (W == 8) return _mm256_min_ps(a, b);
@@ -201,7 +201,7 @@ RTFACT_INLINE V vmax(V a, V b) {
         using E = std::remove_cvref_t<decltype(a[0])>;
         if constexpr (std::is_same_v<E, float>) {
 #if RTFACT_NATIVE_WIDTH >= 16
-            if constexpr (W == 16) return _mm512_max_ps(a, b);
+            if constexpr (W == 16) return _mm512_maskz_max_ps(__mmask16(0xFFFF), a, b);
 #endif
 #if RTFACT_NATIVE_WIDTH >= 8
             if constexpr (W == 8) return _mm256_max_ps(a, b);

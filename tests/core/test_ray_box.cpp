@@ -63,7 +63,9 @@ void check() {
     }
     EXPECT_GT(hits, 0);
     EXPECT_GT(misses, 0);
-    if constexpr (N >= 16) EXPECT_GT(culled, 0);  // the frustum test must cull something
+    if constexpr (N >= 16) {
+        EXPECT_GT(culled, 0);  // the frustum test must cull something
+    }
 }
 
 }  // namespace

@@ -64,7 +64,9 @@ void expectError(const std::string& path, const std::string& needle = "", std::s
         const std::string msg = e.what();
         EXPECT_FALSE(msg.empty());
         EXPECT_EQ(msg.find('\n'), std::string::npos) << "multi-line error: " << msg;
-        if (!needle.empty()) EXPECT_NE(msg.find(needle), std::string::npos) << "message: " << msg;
+        if (!needle.empty()) {
+            EXPECT_NE(msg.find(needle), std::string::npos) << "message: " << msg;
+        }
     }
 }
 

@@ -80,7 +80,9 @@ void check(bool commonOrigin) {
                 // Brute force uses the common-origin form of the test, the structure may not.
                 EXPECT_NEAR(hit.t[i], bt, 1e-4f * std::max(1.0f, bt));
                 // Ids may differ only when two triangles tie at the same distance.
-                if (hit.id[i] != bid) EXPECT_NEAR(hit.t[i], bt, 1e-4f * std::max(1.0f, bt));
+                if (hit.id[i] != bid) {
+                    EXPECT_NEAR(hit.t[i], bt, 1e-4f * std::max(1.0f, bt));
+                }
             }
             // Occlusion with a segment ending before or after the nearest hit.
             RayPacket<N> seg = rays;
