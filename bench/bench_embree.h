@@ -1,10 +1,20 @@
 // Embree helpers shared by the benchmarks that use Embree as the peer.
 #pragma once
 #include <embree3/rtcore.h>
+#include <sys/types.h>
+
+#include <atomic>
 
 #include "core/ray/ray_packet.h"
 
 namespace rtfact::bench {
+
+// Bytes Embree holds, counted through its memory monitor (rtcSetDeviceMemoryMonitorFunction).
+inline std::atomic<int64_t> gEmbreeBytes{0};
+inline bool embreeMemory(void*, ssize_t bytes, bool) {
+    gEmbreeBytes += bytes;
+    return true;
+}
 
 // Fills an Embree 16-ray hit structure from our packet (tnear 0, tfar infinite).
 inline void toEmbree(const RayPacket<16>& rays, RTCRayHit16& rh) {

@@ -203,11 +203,6 @@ void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr,
 
 // ---- Embree -----------------------------------------------------------------------------
 
-std::atomic<int64_t> gEmbreeBytes{0};
-bool embreeMemory(void*, ssize_t bytes, bool) {
-    gEmbreeBytes += bytes;
-    return true;
-}
 
 struct EmbreeSide {
     RTCDevice device = nullptr;

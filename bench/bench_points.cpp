@@ -81,11 +81,6 @@ struct RTfactSide {
     }
 };
 
-std::atomic<int64_t> gEmbreeBytes{0};
-bool embreeMemory(void*, ssize_t bytes, bool) {
-    gEmbreeBytes += bytes;
-    return true;
-}
 
 struct EmbreeSide {
     RTCDevice device = nullptr;

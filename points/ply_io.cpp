@@ -351,6 +351,24 @@ std::optional<PointFileInfo> probePly(const std::string& file) {
     return info;
 }
 
+// Stores one decoded property value of point i (shared by the ASCII and binary paths).
+inline void storeAttr(PointSink& sink, size_t i, Attr a, double x, ScalarType type, bool hasN, bool hasC) {
+    switch (a) {
+        case Attr::X: sink.pos[i][0] = x; break;
+        case Attr::Y: sink.pos[i][1] = x; break;
+        case Attr::Z: sink.pos[i][2] = x; break;
+        case Attr::NX: if (hasN) sink.nrm[i].x = float(x); break;
+        case Attr::NY: if (hasN) sink.nrm[i].y = float(x); break;
+        case Attr::NZ: if (hasN) sink.nrm[i].z = float(x); break;
+        case Attr::R: if (hasC) sink.col[i][0] = colorByte(x, type); break;
+        case Attr::G: if (hasC) sink.col[i][1] = colorByte(x, type); break;
+        case Attr::B: if (hasC) sink.col[i][2] = colorByte(x, type); break;
+        case Attr::Radius: sink.rad[i] = float(x); break;
+        case Attr::Intensity: sink.inten[i] = float(x); break;
+        default: break;
+    }
+}
+
 PointCloud loadPly(const std::string& file) {
     MappedFile f(file);
     const PlyHeader h = parsePlyHeader(f);
@@ -424,20 +442,7 @@ PointCloud loadPly(const std::string& file) {
             for (const auto& p : v->props) {
                 if (p.isList) continue;
                 const double x = vals[s++];
-                switch (attrOf(p.name)) {
-                    case Attr::X: sink.pos[i][0] = x; break;
-                    case Attr::Y: sink.pos[i][1] = x; break;
-                    case Attr::Z: sink.pos[i][2] = x; break;
-                    case Attr::NX: if (hasN) sink.nrm[i].x = float(x); break;
-                    case Attr::NY: if (hasN) sink.nrm[i].y = float(x); break;
-                    case Attr::NZ: if (hasN) sink.nrm[i].z = float(x); break;
-                    case Attr::R: if (hasC) sink.col[i][0] = colorByte(x, p.type); break;
-                    case Attr::G: if (hasC) sink.col[i][1] = colorByte(x, p.type); break;
-                    case Attr::B: if (hasC) sink.col[i][2] = colorByte(x, p.type); break;
-                    case Attr::Radius: sink.rad[i] = float(x); break;
-                    case Attr::Intensity: sink.inten[i] = float(x); break;
-                    default: break;
-                }
+                storeAttr(sink, i, attrOf(p.name), x, p.type, hasN, hasC);
             }
         }
     } else {
@@ -467,20 +472,7 @@ PointCloud loadPly(const std::string& file) {
                     } else {
                         x = readScalar(rec + s.offset, s.type, be);
                     }
-                    switch (s.attr) {
-                        case Attr::X: sink.pos[i][0] = x; break;
-                        case Attr::Y: sink.pos[i][1] = x; break;
-                        case Attr::Z: sink.pos[i][2] = x; break;
-                        case Attr::NX: if (hasN) sink.nrm[i].x = float(x); break;
-                        case Attr::NY: if (hasN) sink.nrm[i].y = float(x); break;
-                        case Attr::NZ: if (hasN) sink.nrm[i].z = float(x); break;
-                        case Attr::R: if (hasC) sink.col[i][0] = colorByte(x, s.type); break;
-                        case Attr::G: if (hasC) sink.col[i][1] = colorByte(x, s.type); break;
-                        case Attr::B: if (hasC) sink.col[i][2] = colorByte(x, s.type); break;
-                        case Attr::Radius: sink.rad[i] = float(x); break;
-                        case Attr::Intensity: sink.inten[i] = float(x); break;
-                        default: break;
-                    }
+                    storeAttr(sink, i, s.attr, x, s.type, hasN, hasC);
                 }
             }
         });
