@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/memory_budget.h"
 #include "points/point_cloud_io.h"
 #include "points/point_cloud_io_detail.h"
 
@@ -154,6 +155,13 @@ PointCloud loadPcd(const std::string& file) {
         h = parsePcdHeader(f);
         validateBody(f, h);
     }
+    {
+        // PCL holds the whole body as one blob (ASCII and compressed bodies expand into it).
+        uint64_t step = 0;
+        for (size_t i = 0; i < h.sizes.size(); ++i) step += uint64_t(h.sizes[i]) * uint64_t(h.counts[i]);
+        checkMemory(file, h.points * step, "the PCL copy of " + std::to_string(h.points) + " points",
+                    "subsample the cloud, e.g. with pcl_voxel_grid");
+    }
     pcl::PCLPointCloud2 c2;
     Eigen::Vector4f origin;
     Eigen::Quaternionf orient;
@@ -206,7 +214,7 @@ PointCloud loadPcd(const std::string& file) {
     if (!has[int(Attr::X)] || !has[int(Attr::Y)] || !has[int(Attr::Z)]) throw Error(file, "PCD points lack x, y or z");
     const bool hasN = has[int(Attr::NX)] && has[int(Attr::NY)] && has[int(Attr::NZ)];
     PointSink sink;
-    sink.reserve(n, hasN, rgbOffset >= 0, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
+    sink.reserve(file, n, hasN, rgbOffset >= 0, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
     for (size_t i = 0; i < n; ++i) {
         const char* rec = reinterpret_cast<const char*>(c2.data.data()) + i * c2.point_step;
         for (const Slot& s : slots) {

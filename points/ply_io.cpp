@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/util/error.h"
+#include "core/util/memory_budget.h"
 #include "points/huge_pages.h"
 #include "points/point_cloud_io.h"
 #include "points/point_cloud_io_detail.h"
@@ -112,7 +113,11 @@ uint8_t colorByte(double v, ScalarType t) {
 }
 
 // Collects one decoded point; finite check and origin shift happen in finish().
-void PointSink::reserve(size_t n, bool normals, bool colors, bool radius, bool intensity) {
+void PointSink::reserve(const std::string& file, size_t n, bool normals, bool colors, bool radius, bool intensity) {
+    // Decoded (double positions) and final (float) copies live together in finish().
+    const uint64_t perPoint = 24 + 12 + (normals ? 24 : 0) + (colors ? 6 : 0) + (radius ? 8 : 0) + (intensity ? 8 : 0);
+    checkMemory(file, uint64_t(n) * perPoint, "loading " + std::to_string(n) + " points",
+                "subsample the cloud, e.g. with pcl_voxel_grid");
     resizeHuge(pos, n);
     if (normals) resizeHuge(nrm, n);
     if (colors) resizeHuge(col, n);
@@ -423,7 +428,7 @@ PointCloud loadPly(const std::string& file) {
                     for (size_t j = 0; j < size_t(c); ++j) tk.number(file);
                 }
         }
-        sink.reserve(n, hasN, hasC, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
+        sink.reserve(file, n, hasN, hasC, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
         std::vector<double> vals(v->props.size());
         for (size_t i = 0; i < n; ++i) {
             size_t slot = 0;
@@ -457,7 +462,7 @@ PointCloud loadPly(const std::string& file) {
             throw Error(file, "PLY header declares " + std::to_string(v->count) + " vertices (" +
                                   std::to_string(v->count * stride) + " bytes) but only " + std::to_string(f.size - pos) +
                                   " bytes follow the header (truncated or lying header)");
-        sink.reserve(n, hasN, hasC, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
+        sink.reserve(file, n, hasN, hasC, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
         const char* base = f.data + pos;
         // Fast path: little-endian float x,y,z.
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {

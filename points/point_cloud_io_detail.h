@@ -36,7 +36,8 @@ struct PointSink {
     std::vector<Vec3f> nrm;
     std::vector<std::array<uint8_t, 3>> col;
     std::vector<float> rad, inten;
-    void reserve(size_t n, bool normals, bool colors, bool radius, bool intensity);
+    // Checks the memory the load needs (core/util/memory_budget.h), then sizes the arrays.
+    void reserve(const std::string& file, size_t n, bool normals, bool colors, bool radius, bool intensity);
     // Drops non-finite points, shifts the origin, moves everything into `out`; throws
     // when nothing is left.
     void finish(const std::string& file, PointCloud& out);

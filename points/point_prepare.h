@@ -3,6 +3,7 @@
 // and per-point radii from the local spacing (distance to the k-th nearest neighbour
 // times a factor, so that neighbouring discs overlap and close the surface).
 #pragma once
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,6 +27,10 @@ struct PrepareReport {
     double normalsMs = 0, radiusMs = 0;
     bool estimatedNormals = false, estimatedRadii = false;
 };
+
+// Peak bytes that preparing a cloud of n points and building its LoD tree need
+// (calibrated on measured peaks); preparePointCloud checks it against the machine first.
+uint64_t pointPipelineBytes(uint64_t n, bool estimateNormals, bool estimateRadii);
 
 // Fills cloud.normals and cloud.radii (throws rtfact::Error on impossible requests,
 // e.g. --normals file for a file without normals).

@@ -1,6 +1,8 @@
 #include "core/util/memory_budget.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -24,6 +26,28 @@ uint64_t readCgroupLimit() {
     return UINT64_MAX;
 }
 
+// RTFACT_MEMORY_LIMIT=2G (or 512M, 64K, bytes): a cap chosen by the user, e.g. to keep
+// room for other jobs; the tests use it to exercise the checks on small files.
+uint64_t readUserLimit() {
+    const char* env = std::getenv("RTFACT_MEMORY_LIMIT");
+    if (!env || !*env) return UINT64_MAX;
+    char* end = nullptr;
+    const double v = std::strtod(env, &end);
+    double scale = 1;
+    switch (*end) {
+        case 'k': case 'K': scale = 1024.0; ++end; break;
+        case 'm': case 'M': scale = 1024.0 * 1024.0; ++end; break;
+        case 'g': case 'G': scale = 1024.0 * 1024.0 * 1024.0; ++end; break;
+        case 't': case 'T': scale = 1024.0 * 1024.0 * 1024.0 * 1024.0; ++end; break;
+        default: break;
+    }
+    if (*end == 'i' || *end == 'B') ++end;  // accept 2GiB / 2GB
+    if (*end == 'B') ++end;
+    if (end == env || *end != '\0' || !(v > 0) || v * scale > 1.8e19)
+        throw Error("RTFACT_MEMORY_LIMIT", std::string("not a size: '") + env + "' (e.g. 512M, 8G)");
+    return uint64_t(v * scale);
+}
+
 }  // namespace
 
 uint64_t availableMemoryBytes() {
@@ -38,7 +62,7 @@ uint64_t availableMemoryBytes() {
             break;
         }
     }
-    const uint64_t limit = readCgroupLimit();
+    const uint64_t limit = std::min(readCgroupLimit(), readUserLimit());
     return avail < limit ? avail : limit;
 }
 

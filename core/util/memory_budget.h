@@ -6,7 +6,8 @@
 
 namespace rtfact {
 
-// Bytes available to this process: MemAvailable, capped by a cgroup limit if any.
+// Bytes available to this process: MemAvailable, capped by a cgroup limit and by the
+// environment variable RTFACT_MEMORY_LIMIT (e.g. 8G) if set.
 uint64_t availableMemoryBytes();
 
 // Throws rtfact::Error(file, ...) when `bytes` exceeds what is available (with a margin),

@@ -97,5 +97,23 @@ hostile zero.mhd volume zero.mhd
 printf '{"colors": [[0, 1, 1]]' > bad.json
 hostile bad.json volume vol.raw --dims 10,10,10 --type u8 --tf bad.json
 
+# Memory estimates checked before allocating (RTFACT_MEMORY_LIMIT caps what the machine has):
+# a clear error naming the file, the need and the option that would help; no image left.
+{ printf 'ply\nformat ascii 1.0\nelement vertex 10000\nproperty float x\nproperty float y\nproperty float z\nend_header\n'
+  awk 'BEGIN { for (i = 0; i < 10000; ++i) print i % 100, int(i / 100), (i * 7) % 13 }'; } > cloud.ply
+RTFACT_MEMORY_LIMIT=256K expect 1 '^rtfact: error: cloud.ply: needs .* for loading 10000 points but only 256 KiB are available \(subsample' -- points cloud.ply --size 8x8 -o hostile.png
+RTFACT_MEMORY_LIMIT=1M expect 1 '^rtfact: error: cloud.ply: needs 1\.1 MiB for preparing and building 10000 points .*\(normal estimation is the largest part' -- points cloud.ply --size 8x8 -o hostile.png
+{ printf 'ply\nformat ascii 1.0\nelement vertex 10000\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n'
+  awk 'BEGIN { for (i = 0; i < 10000; ++i) print i % 100, int(i / 100), 0, 0, 0, 1 }'; } > cloudn.ply
+RTFACT_MEMORY_LIMIT=768K expect 1 '^rtfact: error: cloudn.ply: needs 703 KiB for preparing .* \(subsample' -- points cloudn.ply --radius 0.5 --size 8x8 -o hostile.png
+{ printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 10000\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n'
+  awk 'BEGIN { for (i = 0; i < 10000; ++i) print "3 0 1 2" }'; } > big.ply
+RTFACT_MEMORY_LIMIT=512K expect 1 '^rtfact: error: big.ply: needs .* for 10000 triangles and their BVH .*\(simplify the mesh' -- mesh big.ply --size 8x8 -o hostile.png
+head -c 1000000 /dev/zero > mem.raw
+RTFACT_MEMORY_LIMIT=1M expect 1 '^rtfact: error: mem.raw: needs 1\.9 MiB for the volume .*\(a sparse OpenVDB grid' -- volume mem.raw --dims 100,100,100 --type u8 --size 8x8 -o hostile.png
+RTFACT_MEMORY_LIMIT=1M expect 1 '^rtfact: error: hostile.png: needs .* for a 1024x1024 framebuffer .*\(use a smaller --size\)' -- spheres --size 1024x1024 -o hostile.png
+RTFACT_MEMORY_LIMIT=lots expect 1 "^rtfact: error: RTFACT_MEMORY_LIMIT: not a size: 'lots'" -- spheres --size 8x8 -o hostile.png
+if [ -e hostile.png ]; then echo "FAIL: an image was written although memory checks failed"; fails=$((fails + 1)); fi
+
 echo "$passes passed, $fails failed"
 [ $fails -eq 0 ]
