@@ -71,10 +71,13 @@ std::optional<ScalarType> parseType(const std::string& s) {
 }
 
 double readScalar(const char* p, ScalarType t, bool bigEndian) {
-    unsigned char b[8];
     const int n = typeSize(t);
-    std::memcpy(b, p, size_t(n));
-    if (bigEndian) std::reverse(b, b + n);
+    uint64_t bits = 0;
+    std::memcpy(&bits, p, size_t(n));
+    // Swap in a register (std::reverse on the byte array draws a GCC 12 false warning).
+    if (bigEndian) bits = __builtin_bswap64(bits) >> (64 - 8 * n);
+    unsigned char b[8];
+    std::memcpy(b, &bits, 8);
     switch (t) {
         case ScalarType::I8: return double(int8_t(b[0]));
         case ScalarType::U8: return double(b[0]);
@@ -126,7 +129,12 @@ void PointSink::reserve(const std::string& file, size_t n, bool normals, bool co
 }
 
 namespace {
-bool finite3(const std::array<double, 3>& p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+// Coordinates beyond 1e18 are finite in double but overflow float arithmetic (squared
+// distances) once converted: such points are dropped like NaN/inf ones.
+constexpr double kMaxCoordinate = 1e18;
+bool finite3(const std::array<double, 3>& p) {
+    return std::fabs(p[0]) < kMaxCoordinate && std::fabs(p[1]) < kMaxCoordinate && std::fabs(p[2]) < kMaxCoordinate;
+}
 }  // namespace
 
 void PointSink::finish(const std::string& file, PointCloud& out) {
@@ -151,7 +159,7 @@ void PointSink::finish(const std::string& file, PointCloud& out) {
     for (size_t b = 0; b < blocks; ++b) start[b + 1] += start[b];
     const size_t kept = start[blocks];
     out.droppedNonFinite = n - kept;
-    if (kept == 0) throw Error(file, n == 0 ? "empty point cloud" : "no point with finite coordinates");
+    if (kept == 0) throw Error(file, n == 0 ? "empty point cloud" : "no point with finite coordinates (all NaN, inf or beyond 1e18)");
     resizeHuge(out.positions, kept);
     if (!nrm.empty()) resizeHuge(out.normals, kept);
     if (!col.empty()) out.colors.resize(kept);

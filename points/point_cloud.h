@@ -19,7 +19,7 @@ struct PointCloud {
     std::array<double, 3> origin{0, 0, 0};        // subtracted (in double) from the file's coordinates
     Vec3f viewpoint{0, 0, 0};                     // sensor position (PCD VIEWPOINT), after the shift
     bool hasViewpoint = false;
-    size_t droppedNonFinite = 0;                  // points with NaN/inf coordinates dropped on load
+    size_t droppedNonFinite = 0;                  // points with NaN/inf (or beyond 1e18) coordinates dropped on load
     std::string format;                           // e.g. "ply binary_little_endian"
     std::vector<std::string> properties;          // property names found in the file
 

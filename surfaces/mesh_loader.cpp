@@ -27,6 +27,7 @@
 
 #include "core/util/error.h"
 #include "core/util/memory_budget.h"
+#include "core/util/vtk_quiet.h"
 #include "surfaces/ply_header.h"
 
 namespace rtfact {
@@ -59,61 +60,11 @@ std::string readPrefix(const std::string& file, size_t n) {
 
 // ---- VTK plumbing ----------------------------------------------------------------
 
-// Collects VTK error events of a reader so they become one Error instead of text on
-// stderr.
-struct VtkErrors {
-    std::string first;
-    static void onEvent(vtkObject*, unsigned long, void* client, void* data) {
-        auto* self = static_cast<VtkErrors*>(client);
-        if (self->first.empty() && data) {
-            std::string m = static_cast<const char*>(data);
-            // VTK messages are multi-line with source locations; keep the last line.
-            while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
-            const size_t nl = m.rfind('\n');
-            self->first = nl == std::string::npos ? m : m.substr(nl + 1);
-        }
-        if (self->first.empty()) self->first = "reader error";
-    }
-};
-
-// VTK helpers (XML parser, ...) print errors through the global output window; while
-// a file loads that text is swallowed, our observer turns the reader's error into an
-// Error instead.
-struct QuietVtkOutput {
-    vtkSmartPointer<vtkOutputWindow> previous;
-    vtkNew<vtkStringOutputWindow> text;
-    vtkLogger::Verbosity verbosity;
-    QuietVtkOutput() {
-        previous = vtkOutputWindow::GetInstance();
-        vtkOutputWindow::SetInstance(text);
-        verbosity = vtkLogger::GetCurrentVerbosityCutoff();
-        vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
-    }
-    ~QuietVtkOutput() {
-        vtkOutputWindow::SetInstance(previous);
-        vtkLogger::SetStderrVerbosity(verbosity);
-    }
-    // The last line of the first message VTK emitted (readers warn about truncated data
-    // and go on with what they have: for us that is an error).
-    std::string firstMessage() const {
-        std::string m = text->GetOutput();
-        const size_t end = m.find("\n\n");
-        if (end != std::string::npos) m = m.substr(0, end);
-        while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
-        const size_t nl = m.rfind('\n');
-        return nl == std::string::npos ? m : m.substr(nl + 1);
-    }
-};
-
 template <class Reader>
 vtkPolyData* runReader(Reader* reader, const std::string& file, VtkErrors& errs) {
     QuietVtkOutput quiet;
-    vtkNew<vtkCallbackCommand> cb;
-    cb->SetCallback(&VtkErrors::onEvent);
-    cb->SetClientData(&errs);
-    reader->AddObserver(vtkCommand::ErrorEvent, cb);
-    reader->AddObserver(vtkCommand::WarningEvent, cb);
-    reader->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, cb);
+    errs.observe(reader);
+    reader->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, errs.callback);
     reader->SetFileName(file.c_str());
     reader->Update();
     if (!errs.first.empty()) throw Error(file, errs.first);

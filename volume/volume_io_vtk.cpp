@@ -12,8 +12,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "core/util/error.h"
+#include "core/util/vtk_quiet.h"
 #include "volume/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -71,21 +74,42 @@ VolumeGrid fromImageData(const std::string& path, vtkImageData* img) {
 
 VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
     std::error_code ec;
-    size_t files = 0;
+    std::vector<std::pair<fs::path, uint64_t>> slices;  // DICOM files and their sizes
     for (auto& e : fs::directory_iterator(dir, ec)) {
-        if (!e.is_regular_file()) continue;
+        if (!e.is_regular_file() || e.path().filename() == "DICOMDIR") continue;
         // DICOM part 10 files carry "DICM" at byte 128.
         std::ifstream f(e.path(), std::ios::binary);
         char pre[132] = {};
         f.read(pre, 132);
-        if (f.gcount() == 132 && std::memcmp(pre + 128, "DICM", 4) == 0) ++files;
+        if (f.gcount() == 132 && std::memcmp(pre + 128, "DICM", 4) == 0) slices.emplace_back(e.path(), e.file_size(ec));
     }
+    const size_t files = slices.size();
     if (files == 0) throw Error(dir, "directory holds no DICOM files (no 'DICM' marker at byte 128)");
+    QuietVtkOutput quiet;
+    VtkErrors errs;
     vtkNew<vtkDICOMImageReader> r;
+    errs.observe(r, false);  // it warns about non-DICOM files in the directory and skips them
     r->SetDirectoryName(dir.c_str());
     r->Update();
     vtkImageData* img = r->GetOutput();
-    if (!img || img->GetNumberOfPoints() == 0) throw Error(dir, "VTK could not read the DICOM series");
+    if (!errs.first.empty()) throw Error(dir, "DICOM series: " + errs.first);
+    if (!img || img->GetNumberOfPoints() == 0) {
+        const std::string m = quiet.firstMessage();
+        throw Error(dir, "VTK could not read the DICOM series" + (m.empty() ? std::string() : " (" + m + ")"));
+    }
+    // vtkDICOMImageReader fills slices from truncated files with whatever it finds:
+    // every DICOM file must at least hold one slice of pixel data.
+    int ext[6];
+    img->GetExtent(ext);
+    const uint64_t sliceBytes = uint64_t(ext[1] - ext[0] + 1) * uint64_t(ext[3] - ext[2] + 1) * uint64_t(img->GetScalarSize());
+    for (const auto& [path, size] : slices)
+        if (size < sliceBytes + 132)
+            throw Error(path.string(), "truncated DICOM slice: " + std::to_string(size) + " bytes, one " +
+                                           std::to_string(ext[1] - ext[0] + 1) + "x" + std::to_string(ext[3] - ext[2] + 1) +
+                                           " slice needs " + std::to_string(sliceBytes));
+    if (ext[5] - ext[4] + 1 != int(files))
+        throw Error(dir, "VTK read " + std::to_string(ext[5] - ext[4] + 1) + " slices from " + std::to_string(files) +
+                             " DICOM files (corrupt or mismatched slices)");
     VolumeGrid g = fromImageData(dir, img);
     const float slope = r->GetRescaleSlope(), inter = r->GetRescaleOffset();
     if (std::isfinite(slope) && slope != 0.0f && (slope != 1.0f || inter != 0.0f)) {
@@ -115,10 +139,15 @@ VolumeGrid loadVTI(const std::string& path, const VolumeLoadOptions&) {
     const uint64_t fsz = fs::file_size(path, ec);
     // Compressed (zlib) appended data can shrink at most ~1032:1.
     if (double(n) > double(fsz) * 1100.0 + 4096.0) throw Error(path, "extent claims " + std::to_string(n) + " voxels, more than the file can hold");
+    QuietVtkOutput quiet;
+    VtkErrors errs;
     vtkNew<vtkXMLImageDataReader> r;
+    errs.observe(r);
     if (!r->CanReadFile(path.c_str())) throw Error(path, "VTK cannot read this VTI file");
     r->SetFileName(path.c_str());
     r->Update();
+    if (!errs.first.empty()) throw Error(path, errs.first);
+    if (const std::string m = quiet.firstMessage(); !m.empty()) throw Error(path, m);
     if (r->GetErrorCode() != 0) throw Error(path, "VTK failed to read the VTI file");
     return fromImageData(path, r->GetOutput());
 }

@@ -1,5 +1,6 @@
 #include "core/render/image_io.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
@@ -10,6 +11,7 @@
 #include <random>
 
 #include "core/util/error.h"
+#include "core/util/memory_budget.h"
 
 namespace rtfact {
 
@@ -21,6 +23,40 @@ std::string lowerExt(const std::string& path) {
     std::string e = fs::path(path).extension().string();
     std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     return e;
+}
+
+// libpng and libjpeg print their own diagnostics on stderr before OIIO reports the
+// failure; while an input image is decoded stderr goes to /dev/null, so that the user
+// sees our one-line error only. (Images are read before rendering starts: no other
+// thread is writing to stderr then.)
+class SilenceStderr {
+   public:
+    SilenceStderr() {
+        std::fflush(stderr);
+        saved_ = ::dup(2);
+        const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+        if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+        if (null >= 0) ::close(null);
+    }
+    ~SilenceStderr() {
+        std::fflush(stderr);
+        if (saved_ >= 0) {
+            ::dup2(saved_, 2);
+            ::close(saved_);
+        }
+    }
+    SilenceStderr(const SilenceStderr&) = delete;
+    SilenceStderr& operator=(const SilenceStderr&) = delete;
+
+   private:
+    int saved_ = -1;
+};
+
+// Library messages can span lines; ours are one line.
+std::string oneLine(std::string s) {
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+    std::replace(s.begin(), s.end(), '\n', ' ');
+    return s.empty() ? "unknown error" : s;
 }
 
 bool isFloatFormat(const std::string& ext) { return ext == ".exr" || ext == ".hdr"; }
@@ -61,7 +97,7 @@ void writeImage(const std::string& path, int width, int height, const std::vecto
     const bool floats = isFloatFormat(ext);
     const int channels = floats ? 4 : 3;  // 8-bit images carry the background-composited colour
     auto out = OIIO::ImageOutput::create(tmp);
-    if (!out) throw Error(path, "cannot create image writer: " + OIIO::geterror());
+    if (!out) throw Error(path, "cannot create image writer: " + oneLine(OIIO::geterror()));
     OIIO::ImageSpec spec(width, height, channels, floats ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
     if (!floats) spec.attribute("oiio:ColorSpace", "sRGB");
     bool ok = out->open(tmp, spec);
@@ -81,7 +117,7 @@ void writeImage(const std::string& path, int width, int height, const std::vecto
         ok = out->close() && ok;
     }
     if (!ok) {
-        const std::string err = out->geterror();
+        const std::string err = oneLine(out->geterror());
         out.reset();
         std::error_code ec;
         fs::remove(tmp, ec);
@@ -97,16 +133,35 @@ void writeImage(const std::string& path, int width, int height, const std::vecto
 }
 
 Image readImage(const std::string& path) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw Error(path, "is a directory, not an image");
+    if (!fs::exists(path, ec)) throw Error(path, "no such file or directory");
+    const uint64_t fileBytes = fs::file_size(path, ec);
+    if (ec || fileBytes == 0) throw Error(path, "empty image file");
+    SilenceStderr quiet;
     auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path, "cannot read image: " + OIIO::geterror());
+    if (!in) throw Error(path, "cannot read image: " + oneLine(OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.nchannels > 64 || spec.depth > 1)
+        throw Error(path, "unsupported image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +
+                              std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) + " channels");
+    // A lying header must not make us allocate: no format we read compresses better than
+    // deflate's 1032:1, so 4096 decoded bytes per file byte is a generous bound.
+    const uint64_t decoded = uint64_t(spec.width) * uint64_t(spec.height) * uint64_t(spec.nchannels);
+    if (decoded * spec.format.size() / 4096 > fileBytes)
+        throw Error(path, "image header claims " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                              " pixels, more than a file of " + std::to_string(fileBytes) + " bytes can hold");
+    checkMemory(path, decoded * sizeof(float), "a " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " image",
+                "use a smaller texture");
     Image img;
     img.width = spec.width;
     img.height = spec.height;
     img.channels = spec.nchannels;
-    img.pixels.resize(size_t(img.width) * size_t(img.height) * size_t(img.channels));
+    img.pixels.resize(size_t(decoded));
     if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
-        throw Error(path, "cannot decode image: " + in->geterror());
+        throw Error(path, "cannot decode image: " + oneLine(in->geterror()));
+    for (float v : img.pixels)
+        if (!std::isfinite(v)) throw Error(path, "image holds NaN or infinite values");
     if (spec.format == OIIO::TypeDesc::UINT8) {
         for (size_t i = 0; i < img.pixels.size(); ++i)
             if (img.channels < 4 || i % size_t(img.channels) != 3) img.pixels[i] = fromSRGB(img.pixels[i]);

@@ -96,6 +96,14 @@ printf 'ObjectType = Image\nNDims = 3\nDimSize = 0 5 5\nElementType = MET_UCHAR\
 hostile zero.mhd volume zero.mhd
 printf '{"colors": [[0, 1, 1]]' > bad.json
 hostile bad.json volume vol.raw --dims 10,10,10 --type u8 --tf bad.json
+mkdir -p junkdicom && { head -c 128 /dev/zero; printf DICM; head -c 600 /dev/zero | tr '\0' 'x'; } > junkdicom/a.dcm
+hostile junkdicom volume junkdicom
+# Textures: VTK, libpng and friends print on stderr themselves; the user sees one line.
+printf 'newmtl t\nKd 1 1 1\nmap_Kd tex.png\n' > quad.mtl
+printf 'mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl t\nf 1/1 2/2 3/3\n' > quad.obj
+hostile tex.png mesh quad.obj
+printf '\211PNG\r\n\032\n\0\0\0\rIHDR\0\0\0\002\0\0\0\002\010\002\0\0\0' > tex.png
+hostile tex.png mesh quad.obj
 
 # Memory estimates checked before allocating (RTFACT_MEMORY_LIMIT caps what the machine has):
 # a clear error naming the file, the need and the option that would help; no image left.

@@ -94,8 +94,9 @@ void expectError(F&& f, const std::string& fragment) {
         f();
         ADD_FAILURE() << "no error thrown, expected one mentioning '" << fragment << "'";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << "message: " << e.message();
+        EXPECT_NE(e.message().find(fragment), std::string::npos) << "message: " << e.message();
         EXPECT_FALSE(e.file().empty());
+        EXPECT_EQ(e.message().find('\n'), std::string::npos) << "one line: " << e.message();
     }
 }
 
@@ -167,6 +168,13 @@ TEST(PlyLoader, HostileFiles) {
     expectError([&] { loadPly(writeFile("noxyz.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\nend_header\n1\n")); }, "lack x");
     expectError([&] { loadPly(writeFile("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n1\n")); }, "unknown PLY property type");
     expectError([&] { loadPointCloud((tmpDir() / "missing.ply").string()); }, "cannot open");
+    // Infinite coordinates count as non-finite; a little-endian body declared big-endian
+    // decodes to absurd but finite values, or NaNs: loads or fails cleanly, never crashes.
+    std::string allInf = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\ninf 0 0\n0 -inf 0\n";
+    expectError([&] { loadPly(writeFile("allinf.ply", allInf)); }, "no point with finite coordinates");
+    std::string inf1 = allInf;
+    inf1.replace(inf1.find("0 -inf 0"), 8, "0 1 0");
+    EXPECT_EQ(loadPly(writeFile("oneinf.ply", inf1)).droppedNonFinite, 1u);
     expectError([&] { loadPointCloud(writeFile("x.foo", "1 2 3\n")); }, "unknown point cloud format");
 }
 
@@ -233,6 +241,21 @@ TEST(PcdLoader, HostileFiles) {
     expectError([&] { loadPcd(writeFile("nodata.pcd", "VERSION 0.7\nFIELDS x y z\n")); }, "no DATA");
     expectError([&] { loadPcd(writeFile("asc_trunc.pcd", pcdHeader("ascii", 3) + "1 2 3 4\n1 2 3 4\n")); }, "PCD");
     expectError([&] { loadPcd(writeFile("garbage.pcd", std::string("\x89PNG\r\n\x1a\n", 8) + std::string(64, '\x01'))); }, "PCD");
+    // Negative, zero and overflowing sizes; all-NaN and all-Inf bodies; a directory.
+    expectError([&] { loadPcd(writeFile("negpoints.pcd", pcdHeader("ascii", -3) + "1 2 3 4\n")); }, "PCD");
+    std::string zeroSize = pcdHeader("binary", 1);
+    zeroSize.replace(zeroSize.find("SIZE 4 4 4 4"), 12, "SIZE 4 4 0 4");
+    expectError([&] { loadPcd(writeFile("zerosize.pcd", zeroSize + std::string(16, '\0'))); }, "PCD");
+    std::string hugeCount = pcdHeader("binary", 1);
+    hugeCount.replace(hugeCount.find("COUNT 1 1 1 1"), 13, "COUNT 1 1 1 2000000000");
+    expectError([&] { loadPcd(writeFile("hugecount.pcd", hugeCount + std::string(16, '\0'))); }, "PCD");
+    std::string wh = pcdHeader("binary", 1);
+    wh.replace(wh.find("WIDTH 1\nHEIGHT 1"), 16, "WIDTH 4294967296\nHEIGHT 4294967296");
+    expectError([&] { loadPcd(writeFile("overflow.pcd", wh + std::string(16, '\0'))); }, "PCD");
+    expectError([&] { loadPcd(writeFile("allnan.pcd", pcdHeader("ascii", 2) + "nan 0 0 1\n0 nan 0 1\n")); }, "no point with finite coordinates");
+    expectError([&] { loadPcd(writeFile("allinf.pcd", pcdHeader("ascii", 2) + "inf 0 0 1\n0 -inf 0 1\n")); }, "no point with finite coordinates");
+    fs::create_directories(tmpDir() / "dir.pcd");
+    expectError([&] { loadPointCloud((tmpDir() / "dir.pcd").string()); }, "dir.pcd");
 }
 
 TEST(PcdLoader, SharedKinectFrameDropsNaNs) {
@@ -266,4 +289,11 @@ TEST(XyzLoader, HostileFiles) {
     expectError([&] { loadXyz(writeFile("lying.pts", "1000000000\n0 0 0\n")); }, "file is too small");
     expectError([&] { loadXyz(writeFile("short.pts", "3\n0.000000 0.000000 0.000000\n1.000000 1.000000 1.000000\n")); }, "truncated");
     expectError([&] { loadXyz(writeFile("few.xyz", "1 2\n")); }, "fewer than 3");
+    expectError([&] { loadXyz(writeFile("neg.pts", "-5\n0 0 0\n")); }, "neg.pts");
+    expectError([&] { loadXyz(writeFile("zero.pts", "0\n")); }, "zero.pts");
+    expectError([&] { loadXyz(writeFile("inf.xyz", "inf 0 0\n0 1e39 0\n")); }, "no point with finite coordinates");
+    expectError([&] { loadXyz(writeFile("binary.xyz", std::string("\x7f\x45\x4c\x46\x02\x01\x01\x00\x00\xff", 10))); }, "binary.xyz");
+    expectError([&] { loadPointCloud((tmpDir() / "missing.xyz").string()); }, "missing.xyz");
+    fs::create_directories(tmpDir() / "dir.xyz");
+    expectError([&] { loadPointCloud((tmpDir() / "dir.xyz").string()); }, "dir.xyz");
 }

@@ -3,6 +3,8 @@
 // allocation; the CLI turns it into "rtfact: error: <file>: <what>" and exit code 1.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -196,6 +198,35 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
     std::string badIdx = binaryPly(1, false);
     badIdx[badIdx.size() - 1] = char(0x7f);
     expectError(write("bad_index.ply", badIdx), "refers to vertex");
+    // Wrong magic, negative counts, infinite coordinates, the wrong byte order.
+    expectError(write("magic.ply", "plx\nformat ascii 1.0\nelement vertex 3\nend_header\n"), "");
+    expectError(write("negative.ply", "ply\nformat ascii 1.0\nelement vertex -3\nproperty float x\nend_header\n"), "");
+    expectError(write("inf.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                 "0 0 0\ninf 1 0\n0 1 0\n3 0 1 2\n"),
+                "NaN");
+    std::string swapped = binaryPly(1, false);
+    swapped.replace(swapped.find("little"), 6, "big");  // indices read as 0x01000000...
+    expectError(write("big_endian.ply", swapped), "");
+    expectError(write("inf.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n"), "");
+    expectError(write("zero_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "line 4");
+    expectError(write("negative_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -9 1 2\n"), "line 4");
+    std::string zeroStl(80, ' ');
+    zeroStl.append(4, '\0');
+    expectError(write("zero.stl", zeroStl), "");
+    std::string nanStl(80, ' ');
+    const uint32_t one = 1;
+    nanStl.append(reinterpret_cast<const char*>(&one), 4);
+    const float tri[12] = {0, 0, 1, 0, 0, 0, std::numeric_limits<float>::infinity(), 0, 0, 0, 1, 0};
+    nanStl.append(reinterpret_cast<const char*>(tri), sizeof(tri));
+    nanStl.append(2, '\0');
+    expectError(write("inf.stl", nanStl), "");
+    expectError(write("facets.stl", "solid x\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0\n"), "");
+    for (const char* ext : {".ply", ".obj", ".stl", ".vtk", ".vtp"}) {
+        const std::string d = dir() + "/a_directory" + ext;
+        fs::create_directories(d);
+        expectError(d, "directory");
+    }
     // VTK legacy with fewer coordinates than declared: VTK only warns, we fail.
     expectError(write("short.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\n"
                                    "POLYGONS 1 4\n3 0 1 2\n"));

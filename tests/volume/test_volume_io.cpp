@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "core/util/error.h"
 #include "volume/volume_generators.h"
@@ -167,6 +170,18 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
     expectError([&] { loadVolume(mhd("DimSize = 4 4 4\nElementType = MET_BOGUS\n"), quiet()); }, "unsupported voxel type");
     expectError([&] { loadVolume(mhd("DimSize = 4 4 x\nElementType = MET_UCHAR\n"), quiet()); }, "DimSize");
     expectError([&] { loadVolume(writeFile("n.mhd", "NDims = 3\nDimSize = 4 4 4\n"), quiet()); }, "ElementDataFile");
+    expectError([&] { loadVolume(mhd("DimSize = -4 4 4\nElementType = MET_UCHAR\n"), quiet()); }, "m.mhd");
+    expectError([&] { loadVolume(mhd("DimSize = 4 4 4\nElementSpacing = nan 1 1\nElementType = MET_UCHAR\n"), quiet()); }, "ElementSpacing");
+    expectError([&] { loadVolume(mhd("DimSize = 4 4 4\nElementSpacing = 1 inf 1\nElementType = MET_UCHAR\n"), quiet()); }, "ElementSpacing");
+    expectError([&] { loadVolume(writeFile("gone.mhd", "NDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\nElementDataFile = gone.raw\n"), quiet()); },
+                "gone.raw");
+    expectError([] { parseDims("-1,10,10"); }, "positive");
+    {
+        VolumeLoadOptions skip = o;
+        skip.dims = std::array<int, 3>{2, 2, 2};
+        skip.headerSkip = 5000;
+        expectError([&] { loadVolume(small, skip); }, "small.raw");
+    }
     // NRRD: bad magic, missing type, unsupported encoding, lying sizes, truncated gzip
     expectError([&] { loadVolume(writeFile("b1.nrrd", "NRRX0004\n"), quiet()); }, "NRRD000");
     expectError([&] { loadVolume(writeFile("b2.nrrd", "NRRD0004\nsizes: 2 2 2\nencoding: raw\n\n01234567"), quiet()); }, "type");
@@ -182,6 +197,27 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
     std::string corrupt = gz;
     for (size_t i = 20; i < 60 && i < corrupt.size(); ++i) corrupt[i] = char(0xFF);
     expectError([&] { loadVolume(writeFile("b7.nrrd", "NRRD0004\ntype: uint8\nsizes: 16 16 16\nencoding: gzip\n\n" + corrupt), quiet()); }, "");
+    expectError([&] { loadVolume(writeFile("b8.nrrd", "NRRD0004\ntype: uint8\nsizes: 0 2 2\nencoding: raw\n\n01234567"), quiet()); }, "b8.nrrd");
+    expectError([&] { loadVolume(writeFile("b9.nrrd", "NRRD0004\ntype: uint8\nsizes: 4000000000 4000000000 4000000000\nencoding: raw\n\n0"), quiet()); },
+                "b9.nrrd");
+    expectError([&] { loadVolume(writeFile("b10.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: nowhere.raw\n"), quiet()); },
+                "nowhere.raw");
+    expectError([&] { loadVolume(writeFile("b11.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: gone.%d 1 2 1\n"), quiet()); },
+                "gone.");
+    // NIfTI written on a big-endian machine (byte-swapped header) whose dims lie.
+    {
+        std::string be = niftiHeader(16, 16, 16, 2, 8);
+        auto swap = [&](int off, int n) { std::reverse(be.begin() + off, be.begin() + off + n); };
+        swap(0, 4);
+        for (int i = 0; i < 8; ++i) swap(40 + 2 * i, 2);
+        swap(70, 2), swap(72, 2);
+        for (int i = 0; i < 8; ++i) swap(76 + 4 * i, 4);
+        swap(108, 4), swap(112, 4), swap(116, 4);
+        EXPECT_EQ(loadVolume(writeFile("be.nii", be + data), quiet()).dims[2], 16);  // swapped but honest: loads
+        const int16_t big = 30000;
+        std::memcpy(&be[42], &big, 2);  // x dim 0x3075 read swapped
+        expectError([&] { loadVolume(writeFile("be_lying.nii", be + data), quiet()); }, "be_lying.nii");
+    }
     // NIfTI: bad sizeof_hdr, 4D, truncated gzip
     expectError([&] { loadVolume(writeFile("x.nii", std::string(400, '\0')), quiet()); }, "NIfTI");
     std::string four = niftiHeader(2, 2, 2, 2, 8);
@@ -190,6 +226,16 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
     expectError([&] { loadVolume(writeFile("4d.nii", four + std::string(24, 'x')), quiet()); }, "only 3D");
     const std::string nii = gzip(niftiHeader(16, 16, 16, 2, 8) + data);
     expectError([&] { loadVolume(writeFile("t.nii.gz", nii.substr(0, nii.size() - 40)), quiet()); }, "truncated");
+    // Float voxels that are infinite or NaN read as 0 (documented), they never reach the renderer.
+    {
+        VolumeLoadOptions f = quiet();
+        f.dims = std::array<int, 3>{2, 1, 1};
+        f.type = "f32";
+        const float v[2] = {std::numeric_limits<float>::infinity(), std::nanf("")};
+        const VolumeGrid g = loadVolume(writeFile("inf.raw", std::string(reinterpret_cast<const char*>(v), 8)), f);
+        EXPECT_EQ(g.value(size_t(0)), 0.0f);
+        EXPECT_EQ(g.value(size_t(1)), 0.0f);
+    }
     // OpenVDB: garbage and a truncated header
     expectError([&] { loadVolume(writeFile("g.vdb", std::string(1000, 'z')), quiet()); }, "OpenVDB");
     expectError([&] { loadVolume(writeFile("e.vdb", ""), quiet()); }, "OpenVDB");
@@ -197,6 +243,10 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
     expectError([&] { loadVolume(writeFile("x.vti", "<VTKFile type=\"ImageData\"><ImageData WholeExtent=\"0 99999 0 99999 0 99999\""), quiet()); }, "");
     fs::create_directories(tmpDir() + "/emptydicom");
     expectError([&] { loadVolume(tmpDir() + "/emptydicom", quiet()); }, "DICOM");
+    // A file with the DICM marker and garbage after it: VTK's complaints become one line.
+    fs::create_directories(tmpDir() + "/junkdicom");
+    writeFile("junkdicom/a.dcm", std::string(128, '\0') + "DICM" + std::string(600, '\x33'));
+    expectError([&] { loadVolume(tmpDir() + "/junkdicom", quiet()); }, "junkdicom: ");
     expectError([&] { loadVolume(tmpDir() + "/does-not-exist.mhd", quiet()); }, "no such file");
 }
 
@@ -246,6 +296,23 @@ TEST(VolumeIO, RealDatasets) {
         EXPECT_EQ(g.dims[2], 120);
         EXPECT_NEAR(g.spacing.x, 0.41015625f, 1e-6f);
         EXPECT_NEAR(g.spacing.z, 1.5f, 1e-4f);
+        // The same series with a note next to it loads; with truncated slices it does not.
+        const std::string dir = d + "/dicom_mr_t1_vs_seg_001";
+        const std::string mixed = tmpDir() + "/dicom_mixed", cut = tmpDir() + "/dicom_truncated";
+        fs::remove_all(mixed);
+        fs::remove_all(cut);
+        fs::create_directories(mixed);
+        fs::create_directories(cut);
+        for (const char* n : {"1-001.dcm", "1-002.dcm", "1-003.dcm"}) {
+            fs::copy_file(dir + "/" + n, mixed + "/" + n);
+            std::ifstream f(dir + "/" + n, std::ios::binary);
+            std::string bytes(300000, '\0');
+            f.read(bytes.data(), std::streamsize(bytes.size()));
+            writeFile(std::string("dicom_truncated/") + n, bytes);
+        }
+        writeFile("dicom_mixed/readme.txt", "scanned on a Tuesday\n");
+        EXPECT_EQ(loadVolume(mixed, quiet()).dims[2], 3);
+        expectError([&] { loadVolume(cut, quiet()); }, "truncated DICOM slice");
     }
 }
 
