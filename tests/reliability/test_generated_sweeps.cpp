@@ -547,8 +547,8 @@ TEST(Hostile, VtiTruncatedAndFlipped) {
 }
 
 // Open bug found by these sweeps: OpenVDB reads a cut header past the end of the file and
-// takes garbage string lengths (cut at 105 bytes: ~20 s and a 431 MB "KeyError: Map ..."
-// message; the zip file cut at 522 bytes did not finish within 60 s).
+// takes garbage string lengths: cuts at 105-280 bytes (and a few flips) stall for 20 s or
+// more each (cut at 105: ~20 s, then a 431 MB "KeyError: Map ..." message).
 TEST(Hostile, VdbTruncatedAndFlipped) {
     // Values stored plainly (only inactive tiles are elided, else the internal nodes' tile
     // tables make the file ~160 KB).
