@@ -10,18 +10,25 @@
 #include <cmath>
 
 #include "core/util/error.h"
+#include "volume/vdb_file_check.h"
 #include "volume/volume_io.h"
 
 namespace rtfact::volume {
 
-VolumeGrid loadVDB(const std::string& path, const VolumeLoadOptions& opt) {
+namespace {
+
+// The named (or first) float grid of the file, read by OpenVDB once our own structural check
+// (vdb_file_check.h) has passed: OpenVDB trusts the lengths and counts in the file and, on a
+// truncated or corrupted one, reads past its end, allocates by garbage lengths or stalls.
+openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const VolumeLoadOptions& opt, std::string& name) {
+    checkVdbFile(path);
     openvdb::initialize();
     openvdb::FloatGrid::Ptr grid;
-    std::string name;
+    name.clear();
     try {
         openvdb::io::File file(path);
         file.open(false);  // no delayed loading: corrupt files fail here, not later
-        openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();
+        const openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();  // keep alive while iterating
         for (auto& m : *metas) {
             if (!opt.grid.empty() && m->getName() != opt.grid) continue;
             if (m->valueType() != "float") {
@@ -38,9 +45,20 @@ VolumeGrid loadVDB(const std::string& path, const VolumeLoadOptions& opt) {
     } catch (const Error&) {
         throw;
     } catch (const std::exception& e) {
-        throw Error(path, std::string("cannot read OpenVDB file: ") + e.what());
+        std::string what = e.what();
+        std::replace(what.begin(), what.end(), '\n', ' ');
+        if (what.size() > 300) what = what.substr(0, 300) + "...";
+        throw Error(path, "cannot read OpenVDB file: " + what);
     }
     if (!grid) throw Error(path, "grid '" + name + "' is not a float grid");
+    return grid;
+}
+
+}  // namespace
+
+VolumeGrid loadVDB(const std::string& path, const VolumeLoadOptions& opt) {
+    std::string name;
+    const openvdb::FloatGrid::Ptr grid = readFloatGrid(path, opt, name);
     const openvdb::CoordBBox bb = grid->evalActiveVoxelBoundingBox();
     if (bb.empty()) throw Error(path, "grid '" + name + "' has no active voxels");
     const int64_t d[3] = {int64_t(bb.dim().x()), int64_t(bb.dim().y()), int64_t(bb.dim().z())};
@@ -73,31 +91,8 @@ VolumeGrid loadVDB(const std::string& path, const VolumeLoadOptions& opt) {
 namespace rtfact::volume {
 
 BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& opt) {
-    openvdb::initialize();
-    openvdb::FloatGrid::Ptr grid;
     std::string name;
-    try {
-        openvdb::io::File file(path);
-        file.open(false);
-        const openvdb::GridPtrVecPtr metas = file.readAllGridMetadata();  // keep alive while iterating
-        for (auto& m : *metas) {
-            if (!opt.grid.empty() && m->getName() != opt.grid) continue;
-            if (m->valueType() != "float") {
-                if (!opt.grid.empty()) throw Error(path, "grid '" + opt.grid + "' holds " + m->valueType() + " values, not float");
-                continue;
-            }
-            name = m->getName();
-            break;
-        }
-        if (name.empty()) throw Error(path, opt.grid.empty() ? "no float grid in the file" : "no grid named '" + opt.grid + "'");
-        grid = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
-        file.close();
-    } catch (const Error&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw Error(path, std::string("cannot read OpenVDB file: ") + e.what());
-    }
-    if (!grid) throw Error(path, "grid '" + name + "' is not a float grid");
+    const openvdb::FloatGrid::Ptr grid = readFloatGrid(path, opt, name);
     if (grid->background() != 0.0f) {
         // Unmarked bricks read as zero; a non-zero background needs the dense path.
         VolumeGrid g = loadVDB(path, opt);
