@@ -203,7 +203,7 @@ class TreeWalk {
 
     // Tree::readTopology: int32 buffer count, then RootNode::readTopology.
     void topology() {
-        r_.skip(4, "tree buffer count");
+        if (r_.get<int32_t>("tree buffer count") != 1) r_.fail("tree buffer count is not 1");
         r_.skip(uint64_t(t_.valueSize), "background value");
         const uint32_t tiles = r_.get<uint32_t>("root tile count");
         const uint32_t children = r_.get<uint32_t>("root child count");
