@@ -29,6 +29,7 @@
 #include "core/util/memory_budget.h"
 #include "core/util/vtk_quiet.h"
 #include "surfaces/ply_header.h"
+#include "surfaces/vtk_legacy_check.h"
 
 namespace rtfact {
 namespace fs = std::filesystem;
@@ -175,49 +176,26 @@ void checkStl(const std::string& file) {
     }
 }
 
-// Legacy .vtk: only POLYDATA is a mesh; check the POINTS count against the file size.
+// Legacy .vtk: only POLYDATA is a mesh. Its sections are walked in full before VTK sees
+// the file (vtk_legacy_check.cpp): vtkPolyDataReader crashes on cell lists shorter than
+// declared.
 bool checkVtkLegacy(const std::string& file, bool throwOnBad) {
-    const uint64_t size = fileSize(file);
-    std::ifstream in(file, std::ios::binary);
-    std::string l1, title, fmt, ds;
-    std::getline(in, l1);
-    if (l1.rfind("# vtk DataFile", 0) != 0) {
-        if (throwOnBad) throw Error(file, "not a VTK legacy file (missing '# vtk DataFile' line)");
+    (void)fileSize(file);
+    const VtkLegacyHeader h = readVtkLegacyHeader(file);
+    if (!h.vtk) {
+        if (throwOnBad) throw Error(file, "not a VTK legacy file (missing '# vtk DataFile Version' line)");
         return false;
     }
-    std::getline(in, title);
-    std::getline(in, fmt);
-    while (std::getline(in, ds) && ds.find_first_not_of(" \t\r") == std::string::npos) {}
-    if (ds.find("POLYDATA") == std::string::npos) {
-        if (throwOnBad) throw Error(file, "VTK legacy file is not POLYDATA (" + ds + ")");
-        return false;
-    }
-    const bool binary = fmt.find("BINARY") != std::string::npos;
-    // Every count the reader will allocate for must fit in the file: at least one digit
-    // and a separator per value in ASCII, four bytes per value in binary. Lines inside
-    // binary blocks that happen to start with a keyword are vanishingly unlikely.
-    const long double perValue = binary ? 4 : 2;
-    std::string line;
-    while (std::getline(in, line)) {
-        std::istringstream ls(line);
-        std::string kw;
-        ls >> kw;
-        int perItem = 0;
-        if (kw == "POINTS") perItem = 3;
-        else if (kw == "POLYGONS" || kw == "TRIANGLE_STRIPS" || kw == "LINES" || kw == "VERTICES" ||
-                 kw == "POINT_DATA" || kw == "CELL_DATA")
-            perItem = 1;
-        else continue;
-        std::string tok;
-        while (ls >> tok) {
-            if (tok.empty() || tok.find_first_not_of("0123456789") != std::string::npos) continue;
-            if (tok.size() > 15) throw Error(file, "absurd count in '" + line.substr(0, 60) + "'");
-            const long double n = std::stold(tok);
-            if (n * perItem * perValue > (long double)size)
-                throw Error(file, "truncated or lying VTK header: '" + line.substr(0, 60) + "' cannot fit in " +
-                                      std::to_string(size) + " bytes");
+    if (h.dataset != "POLYDATA") {
+        if (throwOnBad) {
+            const std::string ds = (h.firstKeyword + " " + h.dataset).substr(0, 60);
+            std::string shown;
+            for (const char c : ds) shown += (c >= 0x20 && c < 0x7f) ? c : '?';
+            throw Error(file, "VTK legacy file is not POLYDATA (" + shown + ")");
         }
+        return false;
     }
+    validateVtkLegacyPolyData(file);
     return true;
 }
 
