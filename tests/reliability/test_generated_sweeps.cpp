@@ -440,9 +440,9 @@ TEST(Hostile, StlAsciiTruncatedAndFlipped) {
     EXPECT_GT(o.rejected, 90);
 }
 
-// Open bug found by this sweep: a POLYGONS list shorter than declared (the file cut
-// anywhere after the "POLYGONS 32 128" line, offsets 489-799) crashes vtkPolyDataReader
-// (SIGSEGV in vtkDataReader::ReadString); the header check only bounds counts by the file.
+// Found by this sweep, fixed by surfaces/vtk_legacy_check.cpp: a POLYGONS list shorter
+// than declared (the file cut after the "POLYGONS 32 128" line) crashed vtkPolyDataReader
+// (SIGSEGV in vtkDataReader::ReadString).
 TEST(Hostile, VtkLegacyTruncatedAndFlipped) {
     const std::string bytes = vtkLegacy();
     writeAll(sweepPath(".vtk"), bytes);
@@ -546,9 +546,9 @@ TEST(Hostile, VtiTruncatedAndFlipped) {
     EXPECT_GT(o.rejected, 90);
 }
 
-// Open bug found by these sweeps: OpenVDB reads a cut header past the end of the file and
-// takes garbage string lengths: cuts at 105-280 bytes (and a few flips) stall for 20 s or
-// more each (cut at 105: ~20 s, then a 431 MB "KeyError: Map ..." message).
+// Found by these sweeps, fixed by volume/vdb_file_check.cpp: OpenVDB read a cut header past
+// the end of the file and took garbage string lengths (cut at 105 bytes: ~20 s, then a
+// 431 MB "KeyError: Map ..." message).
 TEST(Hostile, VdbTruncatedAndFlipped) {
     // Values stored plainly (only inactive tiles are elided, else the internal nodes' tile
     // tables make the file ~160 KB).

@@ -227,6 +227,12 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
         fs::create_directories(d);
         expectError(d, "directory");
     }
+    // Legacy VTK cell lists are checked by us before VTK reads them (it segfaulted on these).
+    const std::string vtkHead = "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n";
+    expectError(write("short_polys.vtk", vtkHead + "POLYGONS 2 8\n3 0 1 2\n"), "truncated");
+    expectError(write("bad_cell.vtk", vtkHead + "POLYGONS 1 4\n4 0 1 2\n"), "declares 4 points");
+    expectError(write("bad_vtk_index.vtk", vtkHead + "POLYGONS 1 4\n3 0 1 7\n"), "refers to point 7");
+    expectError(write("bad_section.vtk", vtkHead + "POLYGONZ 1 4\n3 0 1 2\n"), "unsupported legacy VTK section");
     // VTK legacy with fewer coordinates than declared: VTK only warns, we fail.
     expectError(write("short.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\n"
                                    "POLYGONS 1 4\n3 0 1 2\n"));
