@@ -1,6 +1,7 @@
 // PCD through PCL: the header is parsed and checked against the file size here first
 // (PCL trusts lying headers), then PCL reads the body (ascii, binary, LZF compressed).
 #include <pcl/PCLPointCloud2.h>
+#include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
 
 #include <cmath>
@@ -39,8 +40,13 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
         if (eol - pos > 65536) throw Error(file, "PCD header line too long (not a PCD file?)");
         std::string line(f.data + pos, eol - pos);
         pos = std::min(eol + 1, f.size);
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line.empty() || line[0] == '#') continue;
+        if (line.empty()) continue;
+        if (line.back() == '\r') line.pop_back();
+        // PCL ends its header at a line of blanks (e.g. "\r") and then reads the body with
+        // no fields: it crashed on such a file found by fuzz_pcd. Such lines are errors.
+        if (line.find_first_not_of(" \t\r\v\f") == std::string::npos)
+            throw Error(file, "blank line inside the PCD header");
+        if (line[0] == '#') continue;
         std::istringstream ls(line);
         std::string kw;
         ls >> kw;
@@ -117,6 +123,24 @@ void validateBody(const MappedFile& f, const PcdHeader& h) {
         for (int c : h.counts) values += size_t(c);
         if (h.points > remaining / (2 * values))
             throw Error(file, "PCD header declares " + std::to_string(h.points) + " points but the file is too small");
+        // Every point is one line of exactly `values` tokens (PCL only warns and skips).
+        const char* p = f.data + h.bodyOffset;
+        const char* end = f.data + f.size;
+        for (uint64_t i = 0; i < h.points; ++i) {
+            while (p < end && (*p == '\n' || *p == '\r')) ++p;  // PCL skips empty lines
+            if (p == end)
+                throw Error(file, "PCD body ends after " + std::to_string(i) + " of " + std::to_string(h.points) + " points");
+            size_t tokens = 0;
+            bool inToken = false;
+            for (; p < end && *p != '\n'; ++p) {
+                const bool blank = *p == ' ' || *p == '\t' || *p == '\r';
+                tokens += !blank && !inToken;
+                inToken = !blank;
+            }
+            if (tokens != values)
+                throw Error(file, "PCD point " + std::to_string(i + 1) + " has " + std::to_string(tokens) + " values, expected " +
+                                      std::to_string(values));
+        }
     } else if (h.data == "binary") {
         if (h.points > remaining / row)
             throw Error(file, "PCD header declares " + std::to_string(h.points) + " points (" + std::to_string(h.points * row) +
@@ -166,6 +190,8 @@ PointCloud loadPcd(const std::string& file) {
     Eigen::Vector4f origin;
     Eigen::Quaternionf orient;
     int version = 0;
+    // PCL reports on stderr itself ("Possibly malformed PCD file ..."): we report in one line.
+    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
     pcl::PCDReader reader;
     int rc;
     try {

@@ -1,4 +1,5 @@
 // PCL lives here and in pcd_io.cpp only.
+#include <pcl/console/print.h>
 #include <pcl/features/normal_3d_omp.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
@@ -37,6 +38,7 @@ std::vector<Vec3f> estimateNormals(const std::vector<Vec3f>& positions, int k, V
     std::vector<Vec3f> out(positions.size(), Vec3f(0, 0, 1));
     if (positions.size() < 3) return out;
     auto cloud = toPcl(positions);
+    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // no PCL chatter on stderr
     pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne(threads > 0 ? threads : int(std::thread::hardware_concurrency()));
     ne.setInputCloud(cloud);
     ne.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());

@@ -254,6 +254,9 @@ TEST(PcdLoader, HostileFiles) {
     expectError([&] { loadPcd(writeFile("overflow.pcd", wh + std::string(16, '\0'))); }, "PCD");
     expectError([&] { loadPcd(writeFile("allnan.pcd", pcdHeader("ascii", 2) + "nan 0 0 1\n0 nan 0 1\n")); }, "no point with finite coordinates");
     expectError([&] { loadPcd(writeFile("allinf.pcd", pcdHeader("ascii", 2) + "inf 0 0 1\n0 -inf 0 1\n")); }, "no point with finite coordinates");
+    // Found by fuzz_pcd: a "\r" line ends PCL's header parse and PCL then crashed on the body.
+    expectError([&] { loadPcd(writeFile("cr_line.pcd", "#c\r\n\r\n" + pcdHeader("ascii", 1) + "1 2 3 4\n")); }, "blank line");
+    expectError([&] { loadPcd(writeFile("short_row.pcd", pcdHeader("ascii", 2) + "1 2 3 4\n1 2 3\n")); }, "point 2 has 3 values");
     fs::create_directories(tmpDir() / "dir.pcd");
     expectError([&] { loadPointCloud((tmpDir() / "dir.pcd").string()); }, "dir.pcd");
 }
