@@ -256,7 +256,7 @@ TEST(PcdLoader, HostileFiles) {
     expectError([&] { loadPcd(writeFile("allinf.pcd", pcdHeader("ascii", 2) + "inf 0 0 1\n0 -inf 0 1\n")); }, "no point with finite coordinates");
     // Found by fuzz_pcd: a "\r" line ends PCL's header parse and PCL then crashed on the body.
     expectError([&] { loadPcd(writeFile("cr_line.pcd", "#c\r\n\r\n" + pcdHeader("ascii", 1) + "1 2 3 4\n")); }, "blank line");
-    expectError([&] { loadPcd(writeFile("short_row.pcd", pcdHeader("ascii", 2) + "1 2 3 4\n1 2 3\n")); }, "point 2 has 3 values");
+    expectError([&] { loadPcd(writeFile("short_row.pcd", pcdHeader("ascii", 2) + "10 20 30 40\n10 20 30\n")); }, "point 2 has 3 values");
     fs::create_directories(tmpDir() / "dir.pcd");
     expectError([&] { loadPointCloud((tmpDir() / "dir.pcd").string()); }, "dir.pcd");
 }
