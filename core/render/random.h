@@ -1,7 +1,7 @@
 // Stateless per-lane random numbers: a hash of (pixel x, pixel y, sample, dimension),
 // so renders are identical for any thread count, tile order and packet size.
 #pragma once
-#include "core/simd/packet.h"
+#include "core/simd/vec3.h"  // Packet in namespace rtfact
 
 namespace rtfact {
 

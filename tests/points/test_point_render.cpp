@@ -8,6 +8,8 @@
 #include <filesystem>
 
 #include "common/image_compare.h"
+#include "core/render/ao_integrator.h"
+#include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
 #include "core/render/framebuffer.h"
 #include "core/render/pinhole_camera.h"
@@ -39,11 +41,12 @@ bool loadBunny(PointScene& scene, CameraFrame& frame, ColorMode mode = ColorMode
     return true;
 }
 
-std::vector<float> render(const PointScene& scene, const CameraFrame& frame, float quality) {
+template <class Integrator = EyeLightIntegrator>
+std::vector<float> render(const PointScene& scene, const CameraFrame& frame, float quality, const Integrator& integ = {}) {
     const PinholeCamera cam(frame, kSize, kSize);
     const_cast<PointScene&>(scene).setLoD(cam.cone(), quality);
     RGBAFramebuffer fb(kSize, kSize);
-    const RayTracingRenderer<PixelCenterSampler, EyeLightIntegrator> r{{}, {}};
+    const RayTracingRenderer<PixelCenterSampler, Integrator> r{{}, integ};
     RenderOptions ro;
     ro.progress = false;
     renderImage<64>(r, scene, cam, fb, ro);
@@ -51,6 +54,26 @@ std::vector<float> render(const PointScene& scene, const CameraFrame& frame, flo
 }
 
 }  // namespace
+
+// The core's direct-light (with shadow rays) and AO integrators on discs, and the LoD cut.
+TEST(PointRender, DirectAOAndLoDMatchReferences) {
+    PointScene scene;
+    CameraFrame frame;
+    if (!loadBunny(scene, frame)) GTEST_SKIP() << "datasets/points/bunny_bun000.ply not present";
+    const std::string dir = RTFACT_TEST_DATA;
+    DirectLightIntegrator direct;
+    const AABB b = scene.bounds();
+    direct.lights.push_back(PointLight{frame.eye + Vec3f(0, 1, 0) * length(b.extent()), Vec3f(2.5f * dot(b.extent(), b.extent()))});
+    direct.lights.push_back(DirectionalLight{{0.3f, -1.0f, -0.4f}, Vec3f(0.5f)});
+    test::expectMatchesReference(dir + "/bunny_bun000_direct.png", kSize, kSize, render(scene, frame, 0.0f, direct));
+    AOIntegrator ao;
+    ao.samples = 8;
+    ao.offset = 4e-3f;
+    ao.minDistance = 4e-3f;
+    test::expectMatchesReference(dir + "/bunny_bun000_ao.png", kSize, kSize, render(scene, frame, 0.0f, ao));
+    // A coarse cut (quality 8) answers many rays with inner-node splats: its own reference.
+    test::expectMatchesReference(dir + "/bunny_bun000_lod8.png", kSize, kSize, render(scene, frame, 8.0f));
+}
 
 TEST(PointRender, BunnyScanMatchesReference) {
     PointScene scene;
