@@ -29,6 +29,12 @@ struct PcdHeader {
     size_t bodyOffset = 0;
 };
 
+// A decimal integer of at most 6 digits, or -1.
+int smallInt(const std::string& t) {
+    if (t.empty() || t.size() > 6 || t.find_first_not_of("0123456789") != std::string::npos) return -1;
+    return std::stoi(t);
+}
+
 PcdHeader parsePcdHeader(const MappedFile& f) {
     const std::string& file = f.name;
     PcdHeader h;
@@ -62,9 +68,9 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
             std::string s;
             while (ls >> s) h.fields.push_back(s);
         } else if (kw == "SIZE") {
-            int s;
-            while (ls >> s) {
-                if (s != 1 && s != 2 && s != 4 && s != 8) throw Error(file, "bad PCD SIZE " + std::to_string(s));
+            for (std::string t; ls >> t;) {
+                const int s = smallInt(t);
+                if (s != 1 && s != 2 && s != 4 && s != 8) throw Error(file, "bad PCD SIZE '" + t.substr(0, 32) + "'");
                 h.sizes.push_back(s);
             }
         } else if (kw == "TYPE") {
@@ -74,9 +80,11 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
                 h.types.push_back(s[0]);
             }
         } else if (kw == "COUNT") {
-            int s;
-            while (ls >> s) {
-                if (s < 1 || s > 4096) throw Error(file, "bad PCD COUNT " + std::to_string(s));
+            // Every token must be a small integer: a stream read that overflows would just
+            // stop here, and PCL would then allocate by its own reading of the number.
+            for (std::string t; ls >> t;) {
+                const int s = smallInt(t);
+                if (s < 1 || s > 4096) throw Error(file, "bad PCD COUNT '" + t.substr(0, 32) + "'");
                 h.counts.push_back(s);
             }
         } else if (kw == "WIDTH") readCount(h.width);

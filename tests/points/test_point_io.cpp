@@ -249,6 +249,11 @@ TEST(PcdLoader, HostileFiles) {
     std::string hugeCount = pcdHeader("binary", 1);
     hugeCount.replace(hugeCount.find("COUNT 1 1 1 1"), 13, "COUNT 1 1 1 2000000000");
     expectError([&] { loadPcd(writeFile("hugecount.pcd", hugeCount + std::string(16, '\0'))); }, "PCD");
+    // Found by fuzz_pcd: a COUNT that overflows int ended our stream read silently and PCL
+    // then allocated 12 GB by its own reading of the number.
+    std::string overflowCount = pcdHeader("binary", 1);
+    overflowCount.replace(overflowCount.find("COUNT 1 1 1 1"), 13, "COUNT 19999999999999999999999 1 1 1");
+    expectError([&] { loadPcd(writeFile("overflowcount.pcd", overflowCount + std::string(16, '\0'))); }, "bad PCD COUNT");
     std::string wh = pcdHeader("binary", 1);
     wh.replace(wh.find("WIDTH 1\nHEIGHT 1"), 16, "WIDTH 4294967296\nHEIGHT 4294967296");
     expectError([&] { loadPcd(writeFile("overflow.pcd", wh + std::string(16, '\0'))); }, "PCD");
