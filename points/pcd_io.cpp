@@ -4,7 +4,9 @@
 #include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 
@@ -63,10 +65,23 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
                 throw Error(file, "bad PCD " + kw + " value '" + t + "'");
             v = std::stoull(t);
         };
-        if (kw == "VERSION") continue;
+        // PCL's own header parser misbehaves on odd tokens (fuzz_pcd found a crash and a
+        // use-after-free inside it): every token must look like what PCL writes.
+        if (kw == "VERSION") {
+            std::string v;
+            ls >> v;
+            if (v.empty() || v.size() > 8 || v.find_first_not_of("0123456789.") != std::string::npos)
+                throw Error(file, "bad PCD VERSION");
+            continue;
+        }
         if (kw == "FIELDS" || kw == "COLUMNS") {
-            std::string s;
-            while (ls >> s) h.fields.push_back(s);
+            for (std::string s; ls >> s;) {
+                const bool ident = s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) {
+                    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+                });
+                if (!ident) throw Error(file, "bad PCD field name '" + s.substr(0, 32) + "'");
+                h.fields.push_back(s);
+            }
         } else if (kw == "SIZE") {
             for (std::string t; ls >> t;) {
                 const int s = smallInt(t);
@@ -91,7 +106,13 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
         else if (kw == "HEIGHT") readCount(h.height);
         else if (kw == "POINTS") { readCount(h.points); h.havePoints = true; }
         else if (kw == "VIEWPOINT") {
-            for (double& v : h.viewpoint) ls >> v;
+            for (double& v : h.viewpoint) {
+                std::string t;
+                ls >> t;
+                char* end = nullptr;
+                v = std::strtod(t.c_str(), &end);
+                if (t.empty() || *end != '\0' || !std::isfinite(v)) throw Error(file, "bad PCD VIEWPOINT (seven numbers expected)");
+            }
         } else if (kw == "DATA") {
             ls >> h.data;
             haveData = true;

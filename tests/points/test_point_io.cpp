@@ -262,6 +262,12 @@ TEST(PcdLoader, HostileFiles) {
     // Found by fuzz_pcd: a "\r" line ends PCL's header parse and PCL then crashed on the body.
     expectError([&] { loadPcd(writeFile("cr_line.pcd", "#c\r\n\r\n" + pcdHeader("ascii", 1) + "1 2 3 4\n")); }, "blank line");
     expectError([&] { loadPcd(writeFile("short_row.pcd", pcdHeader("ascii", 2) + "10 20 30 40\n10 20 30\n")); }, "point 2 has 3 values");
+    // Odd header tokens that PCL's own parser mishandled (a use-after-free found by fuzz_pcd).
+    std::string oddField = pcdHeader("ascii", 1, "x y z\xec\xec i");
+    expectError([&] { loadPcd(writeFile("oddfield.pcd", oddField + "1 2 3 4\n")); }, "bad PCD field name");
+    std::string oddView = pcdHeader("ascii", 1);
+    oddView.replace(oddView.find("VIEWPOINT 0 0 0 1 0 0 0"), 23, "VIEWPOINT 0 0 0 1 0 0 \x10");
+    expectError([&] { loadPcd(writeFile("oddview.pcd", oddView + "1 2 3 4\n")); }, "bad PCD VIEWPOINT");
     fs::create_directories(tmpDir() / "dir.pcd");
     expectError([&] { loadPointCloud((tmpDir() / "dir.pcd").string()); }, "dir.pcd");
 }
