@@ -5,6 +5,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -513,13 +514,30 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
     } else if (!words.empty() && lower(words[0]) == "list") {
         for (auto& f : dataFileList) files.push_back((dir / f).string());
     } else if (dataFile.find('%') != std::string::npos && words.size() >= 4) {
-        const long lo = long(parseNumber(path, words[1], "data file min")), hi = long(parseNumber(path, words[2], "data file max"));
-        const long step = long(parseNumber(path, words[3], "data file step"));
+        auto index = [&](const std::string& w, const char* what) {
+            const double v = parseNumber(path, w, what);
+            if (!(std::fabs(v) < 1e9) || v != std::floor(v)) throw Error(path, std::string("bad NRRD ") + what);
+            return long(v);
+        };
+        const long lo = index(words[1], "data file min"), hi = index(words[2], "data file max");
+        const long step = index(words[3], "data file step");
         if (step == 0 || (hi - lo) / step < 0 || (hi - lo) / step > 1000000) throw Error(path, "bad NRRD data file range");
+        // The pattern comes from the file: never hand it to printf (fuzz_volume_headers found a
+        // crash with "%s"); only one %d with an optional zero-padded width is accepted.
+        const std::string& pat = words[0];
+        const size_t pc = pat.find('%');
+        size_t q = pc + 1;
+        const bool zero = q < pat.size() && pat[q] == '0';
+        q += zero;
+        int width = 0;
+        while (q < pat.size() && std::isdigit(static_cast<unsigned char>(pat[q])) && width < 100) width = width * 10 + (pat[q++] - '0');
+        if (q >= pat.size() || pat[q] != 'd' || width > 32 || pat.find('%', q) != std::string::npos)
+            throw Error(path, "bad NRRD data file pattern '" + pat.substr(0, 64) + "' (one %d expected)");
         for (long i = lo; step > 0 ? i <= hi : i >= hi; i += step) {
-            char name[4096];
-            std::snprintf(name, sizeof(name), words[0].c_str(), int(i));
-            files.push_back((dir / name).string());
+            std::string num = std::to_string(i < 0 ? -i : i);
+            if (int(num.size()) < width) num.insert(0, size_t(width) - num.size() - (i < 0 ? 1 : 0), zero ? '0' : ' ');
+            if (i < 0) num.insert(zero ? 0 : num.find_first_not_of(' '), "-");  // as printf: "-0005", "   -5"
+            files.push_back((dir / (pat.substr(0, pc) + num + pat.substr(q + 1))).string());
         }
     } else {
         files.push_back((dir / dataFile).string());

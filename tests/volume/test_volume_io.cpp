@@ -150,6 +150,10 @@ TEST(VolumeIO, NrrdAttachedGzipAndDetachedSlices) {
     for (int k = 0; k < 4; ++k) writeFile("sl." + std::to_string(k + 1), data.substr(size_t(k) * 6, 6));
     const VolumeGrid s = loadVolume(writeFile("d.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 3 4\nencoding: raw\ndata file: sl.%d 1 4 1\n"), quiet());
     EXPECT_EQ(std::memcmp(s.bytes.data(), data.data(), 24), 0);
+    // Zero-padded slice numbers, as printf's %03d would write them.
+    for (int k = 0; k < 4; ++k) writeFile("pad" + std::string(k + 1 < 10 ? "00" : "0") + std::to_string(k + 1) + ".raw", data.substr(size_t(k) * 6, 6));
+    const VolumeGrid z = loadVolume(writeFile("p.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 3 4\nencoding: raw\ndata file: pad%03d.raw 1 4 1\n"), quiet());
+    EXPECT_EQ(std::memcmp(z.bytes.data(), data.data(), 24), 0);
 }
 
 TEST(VolumeIO, MalformedInputsGiveClearErrors) {
@@ -202,6 +206,13 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
                 "b9.nrrd");
     expectError([&] { loadVolume(writeFile("b10.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: nowhere.raw\n"), quiet()); },
                 "nowhere.raw");
+    // Found by fuzz_volume_headers: the slice pattern went to printf ("%s" crashed).
+    expectError([&] { loadVolume(writeFile("b12.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%s 1 2 1\n"), quiet()); },
+                "one %d expected");
+    expectError([&] { loadVolume(writeFile("b13.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%d.%d 1 2 1\n"), quiet()); },
+                "one %d expected");
+    expectError([&] { loadVolume(writeFile("b14.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%d 1 1e300 1\n"), quiet()); },
+                "data file max");
     expectError([&] { loadVolume(writeFile("b11.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: gone.%d 1 2 1\n"), quiet()); },
                 "gone.");
     // NIfTI written on a big-endian machine (byte-swapped header) whose dims lie.
