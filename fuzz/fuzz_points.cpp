@@ -8,7 +8,7 @@
 #include "points/point_cloud_io.h"
 #include "points/point_cloud_io_detail.h"
 
-// PCD goes through PCL, which the harness does not link.
+// PCD has its own harness (fuzz_pcd).
 namespace rtfact::points {
 PointCloud loadPcd(const std::string& file) { throw Error(file, "stub"); }
 std::optional<PointFileInfo> probePcd(const std::string& file) { throw Error(file, "stub"); }

@@ -1,8 +1,7 @@
-// PCD through PCL: the header is parsed and checked against the file size here first
-// (PCL trusts lying headers), then PCL reads the body (ascii, binary, LZF compressed).
-#include <pcl/PCLPointCloud2.h>
-#include <pcl/console/print.h>
-#include <pcl/io/pcd_io.h>
+// PCD (PCL's point cloud format): header and body are read by us. PCL's own PCDReader was
+// used for the body until fuzz_pcd found inputs that passed our strict header checks and
+// still crashed inside it (a use-after-free, a 12 GB allocation by a garbage length); the
+// strict header rules below remain, so a file we accept is one PCL can read too.
 
 #include <algorithm>
 #include <cmath>
@@ -189,6 +188,112 @@ void validateBody(const MappedFile& f, const PcdHeader& h) {
     }
 }
 
+
+// Stores an ASCII value with the field's declared type (PCL writes packed rgb as a float
+// whose bits are the colour, or as an unsigned integer).
+void writeScalar(char* dst, char type, int size, double v) {
+    if (type == 'F') {
+        if (size == 8) std::memcpy(dst, &v, 8);
+        else {
+            const float f = float(v);
+            std::memcpy(dst, &f, 4);
+        }
+        return;
+    }
+    // 9.2e18 keeps 8-byte values inside int64_t.
+    const double lo = type == 'U' ? 0.0 : std::max(-9.2e18, -std::ldexp(1.0, 8 * size - 1));
+    const double hi = std::min(9.2e18, type == 'U' ? std::ldexp(1.0, 8 * size) - 1 : std::ldexp(1.0, 8 * size - 1) - 1);
+    const double c = std::isfinite(v) ? std::clamp(std::round(v), lo, hi) : 0.0;
+    const int64_t x = int64_t(c);
+    std::memcpy(dst, &x, size_t(size));  // little-endian: the low bytes
+}
+
+ScalarType scalarTypeOf(char type, int size) {
+    if (type == 'F') return size == 8 ? ScalarType::F64 : ScalarType::F32;  // SIZE checked: 4 or 8
+    const bool u = type == 'U';
+    switch (size) {
+        case 1: return u ? ScalarType::U8 : ScalarType::I8;
+        case 2: return u ? ScalarType::U16 : ScalarType::I16;
+        default: return u ? ScalarType::U32 : ScalarType::I32;  // 8-byte integers: their low 4 bytes
+    }
+}
+
+// LZF as PCL writes it: a control byte c < 32 starts a run of c + 1 literal bytes; otherwise
+// a back reference of (c >> 5) + 2 bytes (7 -> one more length byte) at distance
+// ((c & 31) << 8) + next byte + 1. Every read and write is bounds-checked.
+void lzfDecompress(const std::string& file, const unsigned char* in, size_t inSize, char* out, size_t outSize) {
+    size_t ip = 0, op = 0;
+    auto bad = [&] { throw Error(file, "corrupt PCD compressed block"); };
+    while (ip < inSize) {
+        const unsigned c = in[ip++];
+        if (c < 32) {
+            const size_t len = c + 1;
+            if (ip + len > inSize || op + len > outSize) bad();
+            std::memcpy(out + op, in + ip, len);
+            ip += len, op += len;
+        } else {
+            size_t len = c >> 5;
+            if (ip >= inSize) bad();
+            if (len == 7) {
+                len += in[ip++];
+                if (ip >= inSize) bad();
+            }
+            const size_t dist = ((size_t(c) & 31) << 8) + in[ip++] + 1;
+            len += 2;
+            if (dist > op || op + len > outSize) bad();
+            for (size_t k = 0; k < len; ++k, ++op) out[op] = out[op - dist];  // may overlap
+        }
+    }
+    if (op != outSize) throw Error(file, "PCD compressed block decodes to " + std::to_string(op) + " bytes, expected " + std::to_string(outSize));
+}
+
+// The body as n records of rowSize(h) bytes, whatever its encoding (checked by validateBody).
+std::vector<char> decodeRows(const std::string& file, const PcdHeader& h) {
+    MappedFile f(file);
+    const size_t n = size_t(h.points), row = rowSize(h);
+    std::vector<char> rows(n * row);
+    const char* body = f.data + h.bodyOffset;
+    if (h.data == "binary") {
+        std::memcpy(rows.data(), body, n * row);
+    } else if (h.data == "binary_compressed") {
+        uint32_t csize, usize;
+        std::memcpy(&csize, body, 4);
+        std::memcpy(&usize, body + 4, 4);
+        std::vector<char> soa(usize);
+        lzfDecompress(file, reinterpret_cast<const unsigned char*>(body + 8), csize, soa.data(), soa.size());
+        // Field-major (all x, then all y, ...) to records.
+        size_t src = 0, offset = 0;
+        for (size_t k = 0; k < h.fields.size(); ++k) {
+            const size_t w = size_t(h.sizes[k]) * size_t(h.counts[k]);
+            for (size_t i = 0; i < n; ++i, src += w) std::memcpy(rows.data() + i * row + offset, soa.data() + src, w);
+            offset += w;
+        }
+    } else {
+        // ASCII: one line per point, tokens in field order (validateBody counted them).
+        const char* p = body;
+        const char* end = f.data + f.size;
+        std::string tok;
+        for (size_t i = 0; i < n; ++i) {
+            while (p < end && (*p == '\n' || *p == '\r')) ++p;
+            char* rec = rows.data() + i * row;
+            for (size_t k = 0; k < h.fields.size(); ++k) {
+                for (int c = 0; c < h.counts[k]; ++c, rec += h.sizes[k]) {
+                    while (p < end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
+                    const char* t0 = p;
+                    while (p < end && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n') ++p;
+                    tok.assign(t0, p);
+                    char* e = nullptr;
+                    const double v = std::strtod(tok.c_str(), &e);
+                    if (tok.empty() || *e != '\0')
+                        throw Error(file, "bad number '" + tok.substr(0, 32) + "' for point " + std::to_string(i + 1));
+                    writeScalar(rec, h.types[k], h.sizes[k], v);
+                }
+            }
+            while (p < end && *p != '\n') ++p;
+        }
+    }
+    return rows;
+}
 }  // namespace
 
 std::optional<PointFileInfo> probePcd(const std::string& file) {
@@ -208,30 +313,11 @@ PointCloud loadPcd(const std::string& file) {
         h = parsePcdHeader(f);
         validateBody(f, h);
     }
-    {
-        // PCL holds the whole body as one blob (ASCII and compressed bodies expand into it).
-        uint64_t step = 0;
-        for (size_t i = 0; i < h.sizes.size(); ++i) step += uint64_t(h.sizes[i]) * uint64_t(h.counts[i]);
-        checkMemory(file, h.points * step, "the PCL copy of " + std::to_string(h.points) + " points",
-                    "subsample the cloud, e.g. with pcl_voxel_grid");
-    }
-    pcl::PCLPointCloud2 c2;
-    Eigen::Vector4f origin;
-    Eigen::Quaternionf orient;
-    int version = 0;
-    // PCL reports on stderr itself ("Possibly malformed PCD file ..."): we report in one line.
-    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
-    pcl::PCDReader reader;
-    int rc;
-    try {
-        rc = reader.read(file, c2, origin, orient, version);
-    } catch (const std::exception& e) {
-        throw Error(file, std::string("PCD read failed: ") + e.what());
-    }
-    if (rc < 0) throw Error(file, "PCD body could not be read (truncated or corrupt)");
-    const size_t n = size_t(c2.width) * size_t(c2.height);
-    if (n == 0) throw Error(file, "empty point cloud");
-    if (c2.data.size() < n * c2.point_step) throw Error(file, "PCD body shorter than declared");
+    const size_t n = size_t(h.points);
+    const size_t row = rowSize(h);
+    checkMemory(file, uint64_t(n) * row, "the decoded body of " + std::to_string(n) + " points",
+                "subsample the cloud, e.g. with pcl_voxel_grid");
+    const std::vector<char> rows = decodeRows(file, h);
     struct Slot {
         Attr attr;
         ScalarType type;
@@ -242,36 +328,26 @@ PointCloud loadPcd(const std::string& file) {
     bool has[int(Attr::Count)] = {};
     PointCloud cloud;
     cloud.format = "pcd " + h.data;
-    for (const auto& fld : c2.fields) {
-        cloud.properties.push_back(fld.name);
-        ScalarType t;
-        switch (fld.datatype) {
-            case pcl::PCLPointField::INT8: t = ScalarType::I8; break;
-            case pcl::PCLPointField::UINT8: t = ScalarType::U8; break;
-            case pcl::PCLPointField::INT16: t = ScalarType::I16; break;
-            case pcl::PCLPointField::UINT16: t = ScalarType::U16; break;
-            case pcl::PCLPointField::INT32: t = ScalarType::I32; break;
-            case pcl::PCLPointField::UINT32: t = ScalarType::U32; break;
-            case pcl::PCLPointField::FLOAT32: t = ScalarType::F32; break;
-            case pcl::PCLPointField::FLOAT64: t = ScalarType::F64; break;
-            default: continue;
-        }
-        if (fld.offset + typeSize(t) > c2.point_step) throw Error(file, "PCD field outside the point record");
-        if ((fld.name == "rgb" || fld.name == "rgba") && typeSize(t) == 4) {
-            rgbOffset = int(fld.offset);
+    size_t offset = 0;
+    for (size_t k = 0; k < h.fields.size(); offset += size_t(h.sizes[k]) * size_t(h.counts[k]), ++k) {
+        const std::string& name = h.fields[k];
+        cloud.properties.push_back(name);
+        const ScalarType t = scalarTypeOf(h.types[k], h.sizes[k]);
+        if ((name == "rgb" || name == "rgba") && h.sizes[k] == 4) {
+            rgbOffset = int(offset);
             continue;
         }
-        const Attr a = attrOf(fld.name);
+        const Attr a = attrOf(name);
         if (a == Attr::None || a == Attr::R || a == Attr::G || a == Attr::B || has[int(a)]) continue;
         has[int(a)] = true;
-        slots.push_back({a, t, fld.offset});
+        slots.push_back({a, t, offset});
     }
     if (!has[int(Attr::X)] || !has[int(Attr::Y)] || !has[int(Attr::Z)]) throw Error(file, "PCD points lack x, y or z");
     const bool hasN = has[int(Attr::NX)] && has[int(Attr::NY)] && has[int(Attr::NZ)];
     PointSink sink;
     sink.reserve(file, n, hasN, rgbOffset >= 0, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
     for (size_t i = 0; i < n; ++i) {
-        const char* rec = reinterpret_cast<const char*>(c2.data.data()) + i * c2.point_step;
+        const char* rec = rows.data() + i * row;
         for (const Slot& s : slots) {
             const double x = readScalar(rec + s.offset, s.type, false);
             switch (s.attr) {
