@@ -125,6 +125,9 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
     if (h.counts.empty()) h.counts.assign(h.fields.size(), 1);
     if (h.sizes.size() != h.fields.size() || h.types.size() != h.fields.size() || h.counts.size() != h.fields.size())
         throw Error(file, "PCD header: FIELDS, SIZE, TYPE and COUNT have different lengths");
+    for (size_t k = 0; k < h.fields.size(); ++k)
+        if (h.types[k] == 'F' && h.sizes[k] != 4 && h.sizes[k] != 8)
+            throw Error(file, "PCD field '" + h.fields[k] + "' is a float of " + std::to_string(h.sizes[k]) + " bytes (4 or 8 expected)");
     if (!h.havePoints) h.points = h.width * h.height;
     if (h.width > (uint64_t(1) << 40) || h.height > (uint64_t(1) << 40) || h.width * h.height != h.points)
         throw Error(file, "PCD header: WIDTH x HEIGHT (" + std::to_string(h.width) + " x " + std::to_string(h.height) +

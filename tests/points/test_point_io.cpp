@@ -268,6 +268,10 @@ TEST(PcdLoader, HostileFiles) {
     std::string oddView = pcdHeader("ascii", 1);
     oddView.replace(oddView.find("VIEWPOINT 0 0 0 1 0 0 0"), 23, "VIEWPOINT 0 0 0 1 0 0 \x10");
     expectError([&] { loadPcd(writeFile("oddview.pcd", oddView + "1 2 3 4\n")); }, "bad PCD VIEWPOINT");
+    // Found by fuzz_pcd in our own decoder: a 2-byte float field was read as 4 bytes.
+    std::string halfFloat = pcdHeader("binary", 1);
+    halfFloat.replace(halfFloat.find("SIZE 4 4 4 4"), 12, "SIZE 4 4 4 2");
+    expectError([&] { loadPcd(writeFile("halffloat.pcd", halfFloat + std::string(14, '\0'))); }, "float of 2 bytes");
     fs::create_directories(tmpDir() / "dir.pcd");
     expectError([&] { loadPointCloud((tmpDir() / "dir.pcd").string()); }, "dir.pcd");
 }
