@@ -351,20 +351,8 @@ PointCloud loadPcd(const std::string& file) {
     sink.reserve(file, n, hasN, rgbOffset >= 0, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
     for (size_t i = 0; i < n; ++i) {
         const char* rec = rows.data() + i * row;
-        for (const Slot& s : slots) {
-            const double x = readScalar(rec + s.offset, s.type, false);
-            switch (s.attr) {
-                case Attr::X: sink.pos[i][0] = x; break;
-                case Attr::Y: sink.pos[i][1] = x; break;
-                case Attr::Z: sink.pos[i][2] = x; break;
-                case Attr::NX: if (hasN) sink.nrm[i].x = float(x); break;
-                case Attr::NY: if (hasN) sink.nrm[i].y = float(x); break;
-                case Attr::NZ: if (hasN) sink.nrm[i].z = float(x); break;
-                case Attr::Radius: sink.rad[i] = float(x); break;
-                case Attr::Intensity: sink.inten[i] = float(x); break;
-                default: break;
-            }
-        }
+        // Separate R/G/B fields are skipped above: colour comes from the packed rgb only.
+        for (const Slot& s : slots) storeAttr(sink, i, s.attr, readScalar(rec + s.offset, s.type, false), s.type, hasN, false);
         if (rgbOffset >= 0) {
             uint32_t packed;  // 0x00RRGGBB whatever the declared type (F or U)
             std::memcpy(&packed, rec + rgbOffset, 4);

@@ -364,8 +364,7 @@ std::optional<PointFileInfo> probePly(const std::string& file) {
     return info;
 }
 
-// Stores one decoded property value of point i (shared by the ASCII and binary paths).
-inline void storeAttr(PointSink& sink, size_t i, Attr a, double x, ScalarType type, bool hasN, bool hasC) {
+void detail::storeAttr(PointSink& sink, size_t i, Attr a, double x, ScalarType type, bool hasN, bool hasC) {
     switch (a) {
         case Attr::X: sink.pos[i][0] = x; break;
         case Attr::Y: sink.pos[i][1] = x; break;

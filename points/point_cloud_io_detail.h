@@ -43,6 +43,9 @@ struct PointSink {
     void finish(const std::string& file, PointCloud& out);
 };
 
+// Stores one decoded property value of point i (shared by the PLY and PCD readers).
+void storeAttr(PointSink& sink, size_t i, Attr a, double x, ScalarType type, bool hasN, bool hasC);
+
 }  // namespace rtfact::points::detail
 
 namespace rtfact::points {
