@@ -38,15 +38,15 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
     o->common.packet = 16;
     o->common.addTo(*cmd, "points.png");
     cmd->add_option("FILE", o->file, "Point cloud file (.ply .pcd .xyz .pts)")->required();
-    auto* r = cmd->add_option("--radius", o->radius, "Disc radius for every point (world units)")->check(CLI::PositiveNumber);
+    auto* r = cmd->add_option("--radius", o->radius, "Disc radius for every point (world units)")->check(positiveFinite());
     cmd->add_option("--radius-factor", o->radiusFactor, "Scale of the radii (file radii or neighbour spacing)")
         ->capture_default_str()
-        ->check(CLI::Range(1e-3f, 1e3f))
+        ->check(finiteRange(1e-3, 1e3))
         ->excludes(r);
     cmd->add_option("--normals", o->normals, "auto|estimate|file")->capture_default_str()->check(CLI::IsMember({"auto", "estimate", "file"}));
     cmd->add_option("--lod-quality", o->lodQuality, "Node answered by its representative disc when its size < footprint x Q (0: full detail)")
         ->capture_default_str()
-        ->check(CLI::Range(0.0f, 64.0f));
+        ->check(finiteRange(0.0, 64.0));
     cmd->add_option("--lod", o->lod, "on|off (off = full detail)")->capture_default_str()->check(CLI::IsMember({"on", "off"}));
     cmd->add_option("--color", o->color, "rgb|intensity|lod|normal")->capture_default_str()->check(CLI::IsMember({"rgb", "intensity", "lod", "normal"}));
     cmd->add_option("--integrator", o->integrator, "eyelight|direct|ao")->capture_default_str()->check(CLI::IsMember({"eyelight", "direct", "ao"}));
@@ -134,7 +134,7 @@ void addGenPointsCommand(CLI::App& gen, CommandList& list) {
     cmd->add_option("--count", o->count, "Number of points")->capture_default_str()->check(CLI::Range(1ull, 500000000ull));
     cmd->add_option("-o,--out", o->out, "Output .ply")->required();
     cmd->add_option("--seed", o->seed, "Random seed")->capture_default_str();
-    cmd->add_option("--radius-factor", o->radiusFactor, "Disc radius in units of sqrt(area / (count pi))")->capture_default_str()->check(CLI::Range(0.1f, 100.0f));
+    cmd->add_option("--radius-factor", o->radiusFactor, "Disc radius in units of sqrt(area / (count pi))")->capture_default_str()->check(finiteRange(0.1, 100.0));
     cmd->add_flag("--quiet", o->quiet, "No messages");
     list.push_back({cmd, [o] {
                         const auto t0 = std::chrono::steady_clock::now();

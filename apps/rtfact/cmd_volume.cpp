@@ -79,10 +79,10 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
     o->load.addTo(*cmd);
     cmd->add_option("--tf", o->tf, "Transfer function: preset (ct-bone ct-skin ct-muscle mr-default grayscale viridis inferno cool-warm) or FILE.json");
     cmd->add_option("--mode", o->mode, "dvr|shaded|mip|iso")->capture_default_str()->check(CLI::IsMember({"dvr", "shaded", "mip", "iso"}));
-    cmd->add_option("--iso", o->iso, "Isovalue in data units (iso mode)");
-    cmd->add_option("--step", o->step, "Ray-marching step in voxels")->capture_default_str()->check(CLI::Range(0.01f, 64.0f));
-    cmd->add_option("--window", o->window, "Window width in data units (e.g. Hounsfield)");
-    cmd->add_option("--level", o->level, "Window centre in data units");
+    cmd->add_option("--iso", o->iso, "Isovalue in data units (iso mode)")->check(finiteNumber());
+    cmd->add_option("--step", o->step, "Ray-marching step in voxels")->capture_default_str()->check(finiteRange(0.01, 64.0));
+    cmd->add_option("--window", o->window, "Window width in data units (e.g. Hounsfield)")->check(positiveFinite());
+    cmd->add_option("--level", o->level, "Window centre in data units")->check(finiteNumber());
     cmd->add_option("--clip", o->clips, "Clip axis:lo:hi (fractions, e.g. z:0:0.5); repeatable");
     cmd->add_flag("--no-skip", o->noSkip, "Disable empty-space skipping (for comparisons)");
     list.push_back({cmd, [o] {

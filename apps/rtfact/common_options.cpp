@@ -3,12 +3,57 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <optional>
 #include <sstream>
 
 #include "core/render/packet_dispatch.h"
 #include "core/util/progress.h"
 
 namespace rtfact::app {
+
+namespace {
+std::string shortNumber(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+// Parses the whole text as a double; nullopt when it is not a number.
+std::optional<double> parseNumber(const std::string& text) {
+    if (text.empty()) return std::nullopt;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end != text.c_str() + text.size()) return std::nullopt;
+    return v;
+}
+CLI::Validator numberValidator(std::function<std::string(double)> check, std::string description) {
+    return CLI::Validator(
+        [check = std::move(check)](std::string& text) -> std::string {
+            const std::optional<double> v = parseNumber(text);
+            if (!v) return "expected a number, got '" + text + "'";
+            if (!std::isfinite(*v)) return "expected a finite number, got '" + text + "'";
+            return check(*v);
+        },
+        std::move(description));
+}
+}  // namespace
+
+CLI::Validator finiteRange(double lo, double hi) {
+    const std::string range = shortNumber(lo) + " to " + shortNumber(hi);
+    return numberValidator(
+        [lo, hi, range](double v) { return v < lo || v > hi ? "must be between " + range + ", got " + shortNumber(v) : std::string(); },
+        "NUMBER in [" + range + "]");
+}
+
+CLI::Validator positiveFinite() {
+    return numberValidator([](double v) { return v > 0 ? std::string() : "must be greater than 0, got " + shortNumber(v); },
+                           "POSITIVE");
+}
+
+CLI::Validator finiteNumber() {
+    return numberValidator([](double) { return std::string(); }, "NUMBER");
+}
 
 Vec3f parseVec3(const std::string& text, const std::string& option) {
     Vec3f v;
@@ -58,7 +103,7 @@ void CommonOptions::addTo(CLI::App& cmd, const std::string& defaultOut) {
     cmd.add_option("--eye", eye, "Camera position x,y,z (default: fitted to the scene)");
     cmd.add_option("--at", at, "Camera target x,y,z (default: scene centre)");
     cmd.add_option("--up", up, "Camera up vector x,y,z");
-    cmd.add_option("--fov", fov, "Vertical field of view in degrees")->capture_default_str()->check(CLI::Range(1.0f, 170.0f));
+    cmd.add_option("--fov", fov, "Vertical field of view in degrees")->capture_default_str()->check(finiteRange(1.0, 170.0));
     cmd.add_option("--threads", threads, "Render threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
     cmd.add_option("--packet", packet, "Rays per packet (" + supportedPacketSizes() + ")")->capture_default_str();
     cmd.add_option("--spp", spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 20));

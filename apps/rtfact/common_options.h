@@ -34,6 +34,14 @@ struct CommonOptions {
     CameraFrame frame(const AABB& bounds, Vec3f viewDir = {0.6f, 0.45f, 1.0f}, Vec3f up = {0, 1, 0}) const;
 };
 
+// Validators for floating-point options: CLI::Range and CLI::PositiveNumber let NaN
+// through (every comparison with NaN is false) and print huge bounds in full.
+// finiteRange: a finite number in [lo, hi]; positiveFinite: a finite number > 0;
+// finiteNumber: any finite number.
+CLI::Validator finiteRange(double lo, double hi);
+CLI::Validator positiveFinite();
+CLI::Validator finiteNumber();
+
 // Parses "x,y,z"; throws CLI::ValidationError naming the option.
 Vec3f parseVec3(const std::string& text, const std::string& option);
 // Parses "WxH".
