@@ -29,5 +29,8 @@ rtfact_find_core_dependencies()
 find_package(embree 3 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
-list(APPEND CMAKE_MODULE_PATH /usr/lib/x86_64-linux-gnu/cmake/OpenVDB)
+find_path(RTFACT_OPENVDB_MODULE_DIR FindOpenVDB.cmake PATH_SUFFIXES cmake/OpenVDB
+          PATHS /usr/lib/${CMAKE_LIBRARY_ARCHITECTURE} /usr/local/lib/${CMAKE_LIBRARY_ARCHITECTURE} /usr/lib /usr/local/lib
+          NO_DEFAULT_PATH)
+list(APPEND CMAKE_MODULE_PATH ${RTFACT_OPENVDB_MODULE_DIR})
 find_package(OpenVDB REQUIRED)

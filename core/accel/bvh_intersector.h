@@ -4,6 +4,7 @@
 // culled with an interval-arithmetic frustum test, and any-hit queries stop as soon
 // as every lane has found an occluder.
 #pragma once
+#include "core/util/assert.h"
 #include "core/accel/bvh.h"
 #include "core/accel/ray_box.h"
 #include "core/concepts/intersector.h"
@@ -89,6 +90,7 @@ struct BVHIntersector {
             // Near child first, judged by the first lane of the first active chunk.
             uint32_t nearChild = uint32_t(node.ofs), farChild = nearChild + 1;
             if (frustum ? neg[node.axis()] : rays.dir[node.axis()][k * W] < 0.0f) std::swap(nearChild, farChild);
+            RTFACT_ASSERT(sp + 2 <= kStackSize, "BVH deeper than the traversal stack (builders cap the depth at 64)");
             stack[sp++] = {farChild, uint32_t(k)};
             stack[sp++] = {nearChild, uint32_t(k)};
         }

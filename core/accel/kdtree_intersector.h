@@ -12,6 +12,7 @@
 #pragma once
 #include <new>
 
+#include "core/util/assert.h"
 #include "core/accel/kdtree.h"
 #include "core/accel/ray_box.h"
 #include "core/concepts/intersector.h"
@@ -93,7 +94,9 @@ struct KdTreeIntersector {
                 lo.cell.hi[axis] = node.split;
                 hi.cell.lo[axis] = node.split;
             }
-            if (sp + 2 > kStackSize) continue;  // unreachable with the builder's depth limit
+            // Unreachable with the builder's depth limit; release builds drop the subtree.
+            RTFACT_ASSERT(sp + 2 <= kStackSize, "kd-tree deeper than the traversal stack");
+            if (sp + 2 > kStackSize) continue;
             if (rays.dir[axis][k * W] < 0.0f) {
                 new (&stack[sp++]) Entry(lo);
                 new (&stack[sp++]) Entry(hi);

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "core/util/assert.h"
 #include "core/accel/wide_bvh.h"
 #include "core/concepts/intersector.h"
 
@@ -116,6 +117,7 @@ struct WideBVHIntersector {
                 for (; bits; bits &= bits - 1) {
                     const int c = __builtin_ctzll(bits);
                     const Entry e{n.child[c], n.count[c], tn[c]};
+                    RTFACT_ASSERT(sp < int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the traversal stack");
                     int j = sp++;
                     while (j > base && stack[j - 1].dist < e.dist) {
                         stack[j] = stack[j - 1];
