@@ -20,7 +20,10 @@ class OrthographicCamera {
     }
     template <int N>
     RTFACT_INLINE void generate(const Packet<N>& px, const Packet<N>& py, RayPacket<N>& rays) const {
-        rays.org = Vec3<N>(corner_) + Vec3<N>(du_) * px + Vec3<N>(dv_) * py;
+        // chunk by chunk: bit-identical origins at every packet size (see PinholeCamera)
+        constexpr int W = Packet<N>::W;
+        for (int k = 0; k < Packet<N>::C; ++k)
+            rays.org.setChunk(k, Vec3<W>(corner_) + Vec3<W>(du_) * px.chunk(k) + Vec3<W>(dv_) * py.chunk(k));
         rays.dir = Vec3<N>(fwd_);
         rays.tMin = Packet<N>(0.0f);
         rays.tMax = Packet<N>(kInfinity);

@@ -28,11 +28,18 @@ class PinholeCamera {
     }
 
     // (px, py): continuous pixel coordinates, (0, 0) the top-left corner of the image.
+    // Chunk by chunk, so that every packet size runs the same native-width expression and
+    // the compiler contracts it into the same FMAs: a pixel's ray is bit-identical for
+    // any N. (Whole-packet arithmetic on 32 AVX2 chunks was left uncontracted, and rays
+    // differed from the 64-ray packets' in the last bit.)
     template <int N>
     RTFACT_INLINE void generate(const Packet<N>& px, const Packet<N>& py, RayPacket<N>& rays) const {
-        const Vec3<N> d = Vec3<N>(corner_) + Vec3<N>(du_) * px + Vec3<N>(dv_) * py;
+        constexpr int W = Packet<N>::W;
+        for (int k = 0; k < Packet<N>::C; ++k) {
+            const Vec3<W> d = Vec3<W>(corner_) + Vec3<W>(du_) * px.chunk(k) + Vec3<W>(dv_) * py.chunk(k);
+            rays.dir.setChunk(k, normalize(d));
+        }
         rays.org = Vec3<N>(frame_.eye);
-        rays.dir = normalize(d);
         rays.tMin = Packet<N>(0.0f);
         rays.tMax = Packet<N>(kInfinity);
         rays.commonOrigin = true;
