@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <optional>
+#include <string>
 
 #include "core/util/error.h"
 #include "core/util/memory_budget.h"
@@ -23,15 +25,34 @@ TEST(MemoryBudget, RejectsAbsurdRequestsWithAHint) {
     EXPECT_EQ(formatBytes(3u << 20), "3.0 MiB");
 }
 
+// Restores an environment variable when the test leaves, even through an exception, so
+// that later tests in the same process do not inherit the cap.
+class ScopedEnv {
+   public:
+    explicit ScopedEnv(const char* name) : name_(name) {
+        if (const char* v = std::getenv(name)) old_ = v;
+    }
+    ~ScopedEnv() {
+        if (old_) ::setenv(name_, old_->c_str(), 1);
+        else ::unsetenv(name_);
+    }
+    void set(const char* value) const { ::setenv(name_, value, 1); }
+
+   private:
+    const char* name_;
+    std::optional<std::string> old_;
+};
+
 TEST(MemoryBudget, UserLimitFromTheEnvironment) {
-    ::setenv("RTFACT_MEMORY_LIMIT", "64M", 1);
+    const ScopedEnv env("RTFACT_MEMORY_LIMIT");
+    env.set("64M");
     EXPECT_EQ(availableMemoryBytes(), uint64_t(64) << 20);
     EXPECT_NO_THROW(checkMemory("a.ply", 32u << 20, "a cloud"));
     EXPECT_THROW(checkMemory("a.ply", 60u << 20, "a cloud"), Error);  // above 90 % of the cap
-    ::setenv("RTFACT_MEMORY_LIMIT", "1.5GiB", 1);
+    env.set("1.5GiB");
     EXPECT_EQ(availableMemoryBytes(), uint64_t(1.5 * 1024 * 1024 * 1024));
     for (const char* bad : {"lots", "12Q", "-1G", "0"}) {
-        ::setenv("RTFACT_MEMORY_LIMIT", bad, 1);
+        env.set(bad);
         try {
             availableMemoryBytes();
             ADD_FAILURE() << "accepted RTFACT_MEMORY_LIMIT=" << bad;
@@ -39,7 +60,6 @@ TEST(MemoryBudget, UserLimitFromTheEnvironment) {
             EXPECT_EQ(e.file(), "RTFACT_MEMORY_LIMIT");
         }
     }
-    ::unsetenv("RTFACT_MEMORY_LIMIT");
 }
 
 TEST(ErrorFormat, FileAndMessage) {
