@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
 #include "points/huge_pages.h"
 #include "points/point_cloud_io.h"
@@ -26,6 +27,7 @@ namespace rtfact::points {
 namespace detail {
 
 MappedFile::MappedFile(const std::string& file) : name(file) {
+    requireRegularFile(file);  // open() itself would block on a named pipe without a writer
     const int fd = ::open(file.c_str(), O_RDONLY);
     if (fd < 0) throw Error(file, std::string("cannot open: ") + std::strerror(errno));
     struct stat st {};
@@ -218,11 +220,24 @@ PlyHeader parsePlyHeader(const MappedFile& f) {
     const std::string& file = f.name;
     if (f.size < 4 || std::memcmp(f.data, "ply", 3) != 0 || (f.data[3] != '\n' && f.data[3] != '\r'))
         throw Error(file, "not a PLY file (missing 'ply' magic)");
-    const size_t limit = std::min<size_t>(f.size, 1 << 20);
+    // The header is searched within its first 1 MiB only: a file without end_header there
+    // is not read further (a hostile comment of megabytes would otherwise be parsed whole).
+    constexpr size_t kMaxHeader = size_t(1) << 20;
+    const size_t limit = std::min(f.size, kMaxHeader);
     const std::string_view head(f.data, limit);
-    size_t end = head.find("end_header");
+    // end_header as a line of its own (not inside a comment).
+    size_t end = 0;
+    for (size_t from = 0;; from = end + 1) {
+        end = head.find("end_header", from);
+        if (end == std::string_view::npos) break;
+        const size_t after = end + 10;
+        const bool lineEnds = after >= head.size() || head[after] == '\n' || head[after] == '\r' || head[after] == ' ';
+        if (end > 0 && head[end - 1] == '\n' && lineEnds) break;
+    }
+    const size_t body = end == std::string_view::npos ? end : head.find('\n', end);
+    if (body == std::string_view::npos && f.size > kMaxHeader)
+        throw Error(file, "PLY header longer than the 1 MiB limit (no end_header line in the first 1048576 bytes)");
     if (end == std::string_view::npos) throw Error(file, "PLY header has no end_header (truncated?)");
-    size_t body = head.find('\n', end);
     if (body == std::string_view::npos) throw Error(file, "PLY header not terminated by a newline");
     PlyHeader h;
     h.bodyOffset = body + 1;

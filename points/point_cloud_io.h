@@ -12,6 +12,9 @@ namespace rtfact::points {
 
 // Loads any supported file, chosen by extension (.ply .pcd .xyz .pts .txt).
 PointCloud loadPointCloud(const std::string& file);
+// What a loaded cloud lost, as one line for a warning: "FILE: 12 points with non-finite
+// coordinates dropped"; empty when nothing was dropped.
+std::string droppedPointsMessage(const std::string& file, const PointCloud& cloud);
 PointCloud loadPly(const std::string& file);
 PointCloud loadPcd(const std::string& file);
 PointCloud loadXyz(const std::string& file);

@@ -36,9 +36,14 @@ uint64_t pointPipelineBytes(uint64_t n, bool estimateNormals, bool estimateRadii
 // e.g. --normals file for a file without normals).
 PrepareReport preparePointCloud(PointCloud& cloud, const PrepareOptions& opt, const std::string& file);
 
-// Normal estimation alone (k nearest neighbours, PCA), oriented towards `viewpoint`.
+// Both k-NN estimates below treat copies of a position as one point (duplicates are
+// collapsed before the search and the results copied back to every copy).
+// Normal estimation alone (k nearest neighbours, PCA), oriented towards `viewpoint`;
+// points without a plane (fewer than three distinct positions) face the viewpoint.
 std::vector<Vec3f> estimateNormals(const std::vector<Vec3f>& positions, int k, Vec3f viewpoint, int threads = 0);
-// Distance from each point to its k-th nearest neighbour (0 when the cloud has <= k points).
+// Distance from each point to its k-th nearest other position; in a cloud of at most k
+// positions half the distance to the nearest other one (discs that touch, not cover each
+// other); 0 when all points coincide.
 std::vector<float> neighbourSpacing(const std::vector<Vec3f>& positions, int k);
 
 enum class ColorMode { Rgb, Intensity, Lod, Normal };

@@ -157,6 +157,12 @@ PointCloud loadPointCloud(const std::string& file) {
     throw Error(file, "unknown point cloud format '" + e + "' (expected .ply, .pcd, .xyz, .pts)");
 }
 
+std::string droppedPointsMessage(const std::string& file, const PointCloud& cloud) {
+    const size_t n = cloud.droppedNonFinite;
+    if (n == 0) return {};
+    return file + ": " + std::to_string(n) + (n == 1 ? " point" : " points") + " with non-finite coordinates dropped";
+}
+
 std::optional<PointFileInfo> probePointFile(const std::string& file) {
     const std::string e = lowerExt(file);
     if (e == ".ply") return probePly(file);

@@ -64,6 +64,9 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
                         stats.add("points", (unsigned long long)cloud.size());
                         stats.add("load_points_per_s", loadMs > 0 ? double(cloud.size()) / (loadMs * 1e-3) : 0.0);
                         stats.add("dropped_nonfinite", (unsigned long long)cloud.droppedNonFinite);
+                        // Points lost on load are worth one line (all lost is an error in the loader).
+                        if (const std::string w = droppedPointsMessage(o->file, cloud); !w.empty() && !c.quiet)
+                            std::fprintf(stderr, "rtfact: warning: %s\n", w.c_str());
                         const CameraFrame frame = c.frame(cloud.bounds());
                         PrepareOptions po;
                         po.normals = o->normals;

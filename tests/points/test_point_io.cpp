@@ -3,10 +3,17 @@
 // message, never a crash or a huge allocation.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <future>
 
 #include "core/util/error.h"
 #include "points/point_cloud_io.h"
@@ -167,7 +174,7 @@ TEST(PlyLoader, HostileFiles) {
     expectError([&] { loadPly(writeFile("allnan.ply", allNan)); }, "no point with finite coordinates");
     expectError([&] { loadPly(writeFile("noxyz.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\nend_header\n1\n")); }, "lack x");
     expectError([&] { loadPly(writeFile("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n1\n")); }, "unknown PLY property type");
-    expectError([&] { loadPointCloud((tmpDir() / "missing.ply").string()); }, "cannot open");
+    expectError([&] { loadPointCloud((tmpDir() / "missing.ply").string()); }, "no such file");
     // Infinite coordinates count as non-finite; a little-endian body declared big-endian
     // decodes to absurd but finite values, or NaNs: loads or fails cleanly, never crashes.
     std::string allInf = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\ninf 0 0\n0 -inf 0\n";
@@ -314,4 +321,119 @@ TEST(XyzLoader, HostileFiles) {
     expectError([&] { loadPointCloud((tmpDir() / "missing.xyz").string()); }, "missing.xyz");
     fs::create_directories(tmpDir() / "dir.xyz");
     expectError([&] { loadPointCloud((tmpDir() / "dir.xyz").string()); }, "dir.xyz");
+}
+
+// Every format drops points with a NaN, an inf or a coordinate beyond 1e18 and counts
+// them (the CLI warns with droppedPointsMessage); a file with nothing else is an error.
+TEST(NonFinitePoints, CountedInEveryFormatAndAllDroppedIsAnError) {
+    // Five points: two finite, then NaN, inf and 1e30 in turn.
+    const double v[5][3] = {{0, 0, 0}, {1, 2, 3}, {NAN, 1, 1}, {1, INFINITY, 1}, {1, 1, 1e30}};
+    auto text = [&](int first, const std::string& sep) {
+        std::string s;
+        for (int i = first; i < 5; ++i) {
+            for (int a = 0; a < 3; ++a) {
+                const double x = v[i][a];
+                s += (std::isnan(x) ? std::string("nan") : std::isinf(x) ? std::string("inf") : std::to_string(x)) + (a < 2 ? " " : "");
+            }
+            s += sep + "\n";
+        }
+        return s;
+    };
+    auto plyBinary = [&](int first) {
+        std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(5 - first) +
+                        "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+        for (int i = first; i < 5; ++i)
+            for (int a = 0; a < 3; ++a) put(s, v[i][a]);
+        return s;
+    };
+    auto plyAscii = [&](int first) {
+        return "ply\nformat ascii 1.0\nelement vertex " + std::to_string(5 - first) +
+               "\nproperty double x\nproperty double y\nproperty double z\nend_header\n" + text(first, "");
+    };
+    auto pcdAscii = [&](int first) {
+        return "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + std::to_string(5 - first) +
+               "\nHEIGHT 1\nPOINTS " + std::to_string(5 - first) + "\nDATA ascii\n" + text(first, "");
+    };
+    auto pcdBinary = [&](int first) {
+        std::string s = "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + std::to_string(5 - first) +
+                        "\nHEIGHT 1\nPOINTS " + std::to_string(5 - first) + "\nDATA binary\n";
+        for (int i = first; i < 5; ++i)
+            for (int a = 0; a < 3; ++a) put(s, v[i][a]);
+        return s;
+    };
+    auto xyz = [&](int first) { return text(first, ""); };
+    auto pts = [&](int first) { return std::to_string(5 - first) + "\n" + text(first, " 0 10 20 30"); };
+    const std::vector<std::pair<std::string, std::function<std::string(int)>>> formats = {
+        {"ply", plyBinary}, {"ply", plyAscii}, {"pcd", pcdAscii}, {"pcd", pcdBinary}, {"xyz", xyz}, {"pts", pts}};
+    int k = 0;
+    for (const auto& [ext, make] : formats) {
+        SCOPED_TRACE(ext + " #" + std::to_string(k));
+        const std::string f = writeFile("nonfinite" + std::to_string(k) + "." + ext, make(0));
+        const PointCloud c = loadPointCloud(f);
+        ASSERT_EQ(c.size(), 2u);
+        EXPECT_EQ(c.positions[1], Vec3f(1, 2, 3));
+        EXPECT_EQ(c.droppedNonFinite, 3u);
+        EXPECT_EQ(droppedPointsMessage(f, c), f + ": 3 points with non-finite coordinates dropped");
+        const std::string all = writeFile("allnonfinite" + std::to_string(k) + "." + ext, make(2));
+        try {
+            loadPointCloud(all);
+            ADD_FAILURE() << all << ": loaded although every point is non-finite";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.file(), all);
+            EXPECT_NE(e.message().find("no point with finite coordinates"), std::string::npos) << e.message();
+            EXPECT_EQ(e.message().find('\n'), std::string::npos);
+        }
+        ++k;
+    }
+}
+
+TEST(NonFinitePoints, MessageIsOneLineAndOnlyWhenSomethingWasDropped) {
+    PointCloud c;
+    EXPECT_EQ(droppedPointsMessage("a.xyz", c), "");
+    c.droppedNonFinite = 1;
+    EXPECT_EQ(droppedPointsMessage("a.xyz", c), "a.xyz: 1 point with non-finite coordinates dropped");
+}
+
+// A named pipe blocks open() until a writer appears: every loader and probe must refuse
+// it before opening. A loader that still blocks fails here (the pipe's write end is then
+// opened to release it) instead of hanging the test run.
+TEST(PointLoaders, NamedPipesAreRefusedWithoutHanging) {
+    for (const std::string ext : {"xyz", "ply", "pcd", "pts"}) {
+        const std::string fifo = (tmpDir() / ("pipe." + ext)).string();
+        std::filesystem::remove(fifo);
+        ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << fifo << ": " << std::strerror(errno);
+        for (const bool probe : {false, true}) {
+            auto result = std::async(std::launch::async, [&]() -> std::string {
+                try {
+                    if (probe) probePointFile(fifo);
+                    else loadPointCloud(fifo);
+                    return "no error";
+                } catch (const Error& e) {
+                    return e.message();
+                }
+            });
+            if (result.wait_for(std::chrono::seconds(30)) != std::future_status::ready) {
+                ADD_FAILURE() << fifo << (probe ? " (probe)" : "") << ": blocked opening the named pipe";
+                const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+                if (fd >= 0) ::close(fd);
+            }
+            const std::string msg = result.get();
+            EXPECT_EQ(msg, fifo + ": is a named pipe, not a regular file") << (probe ? "probe" : "load");
+        }
+        std::filesystem::remove(fifo);
+    }
+}
+
+// The header search stops after 1 MiB: a longer header (here a 2 MiB comment) is refused
+// naming that limit, not as a file without end_header.
+TEST(PlyLoader, HeaderLimitIsNamed) {
+    const std::string body = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n";
+    const std::string longComment = "ply\nformat ascii 1.0\ncomment " + std::string(2 << 20, 'c') + "\n" + body;
+    expectError([&] { loadPly(writeFile("long_comment.ply", longComment)); }, "longer than the 1 MiB limit");
+    // end_header inside a comment does not end the header.
+    const PointCloud c = loadPly(writeFile("comment_end.ply", "ply\nformat ascii 1.0\ncomment no end_header here\n" + body));
+    ASSERT_EQ(c.size(), 1u);
+    EXPECT_EQ(c.positions[0], Vec3f(1, 2, 3));
+    // Without end_header in a short file: still the truncation message.
+    expectError([&] { loadPly(writeFile("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 1\n")); }, "no end_header");
 }
