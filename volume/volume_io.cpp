@@ -59,7 +59,10 @@ uint64_t fileSize(const std::string& path) {
     return s;
 }
 
-// Sequential bytes from a file at an offset, raw or zlib/gzip compressed.
+// Sequential bytes from a file at an offset, raw or zlib/gzip compressed. A compressed
+// stream is only complete once zlib has seen its end and checked its trailer (CRC-32 and
+// length for gzip, Adler-32 for zlib): finish() decodes up to there, so a stream cut after
+// the bytes a header asks for is an error rather than a silent success.
 class ByteStream {
    public:
     ByteStream(const std::string& path, uint64_t offset, bool compressed) : path_(path), compressed_(compressed) {
@@ -94,38 +97,75 @@ class ByteStream {
             n -= k;
         }
     }
+    // Compressed: decodes (and drops) the rest of the stream, checking every member's
+    // trailer; throws when the file ends inside a member.
+    void finish() {
+        if (!compressed_) return;
+        std::vector<uint8_t> tmp(1 << 16);
+        while (readSome(tmp.data(), tmp.size()) == tmp.size()) {
+        }
+    }
 
    private:
     size_t readSome(uint8_t* dst, size_t n) {
         if (!compressed_) return std::fread(dst, 1, n, f_);
         z_.next_out = dst;
         z_.avail_out = uInt(n);
-        size_t done = 0;
-        while (z_.avail_out > 0) {
-            if (z_.avail_in == 0) {
-                const size_t k = std::fread(in_, 1, sizeof(in_), f_);
-                if (k == 0) break;
-                z_.next_in = in_;
-                z_.avail_in = uInt(k);
-            }
-            const int r = inflate(&z_, Z_NO_FLUSH);
-            if (r == Z_STREAM_END) {
-                // Concatenated gzip members: continue with the next one.
-                if (z_.avail_in == 0 && std::feof(f_)) break;
-                if (inflateReset(&z_) != Z_OK) break;
-                continue;
-            }
-            if (r != Z_OK && r != Z_BUF_ERROR) throw Error(path_, std::string("corrupt compressed data (zlib: ") + (z_.msg ? z_.msg : "error") + ")");
-            if (r == Z_BUF_ERROR && z_.avail_in == 0 && std::feof(f_)) break;
-        }
-        done = n - z_.avail_out;
-        return done;
+        while (z_.avail_out > 0 && !ended_) step();
+        return n - z_.avail_out;
     }
+    // One inflate call (or the input it needs). Ends cleanly only at the end of the file
+    // after a complete member (optionally followed by zero padding, as gzip -d accepts).
+    void step() {
+        if (z_.avail_in == 0) {
+            const size_t k = std::fread(in_, 1, sizeof(in_), f_);
+            if (k == 0) {
+                if (std::ferror(f_)) throw Error(path_, "read error in compressed data");
+                if (inMember_)
+                    throw Error(path_, "truncated compressed data: the file ends before the end of the " + format() +
+                                           " stream and its " + trailer() + " trailer");
+                ended_ = true;
+                return;
+            }
+            z_.next_in = in_;
+            z_.avail_in = uInt(k);
+        }
+        if (!inMember_ && members_ > 0) {
+            // after a complete member: zero padding to the end of the file, or another member
+            while (z_.avail_in > 0 && *z_.next_in == 0) {
+                ++z_.next_in;
+                --z_.avail_in;
+                padding_ = true;
+            }
+            if (z_.avail_in == 0) return;
+            if (padding_) throw Error(path_, "unexpected bytes after the end of the compressed data");
+            if (inflateReset(&z_) != Z_OK) throw Error(path_, "cannot reset zlib");
+        }
+        if (!inMember_) gzip_ = z_.avail_in >= 2 && z_.next_in[0] == 0x1f && z_.next_in[1] == 0x8b;
+        inMember_ = true;
+        const uInt before = z_.avail_in;
+        const int r = inflate(&z_, Z_NO_FLUSH);
+        if (r == Z_STREAM_END) {
+            inMember_ = false;
+            ++members_;
+            return;
+        }
+        if (r == Z_OK || (r == Z_BUF_ERROR && (z_.avail_in == 0 || z_.avail_in != before))) return;
+        const std::string msg = z_.msg ? z_.msg : "error " + std::to_string(r);
+        if (msg == "incorrect data check" || msg == "incorrect length check")
+            throw Error(path_, "corrupt compressed data: " + trailer() + " trailer does not match the data (zlib: " + msg + ")");
+        throw Error(path_, "corrupt compressed data (zlib: " + msg + ")");
+    }
+    std::string format() const { return gzip_ ? "gzip" : "zlib"; }
+    std::string trailer() const { return gzip_ ? "CRC-32/length" : "Adler-32"; }
+
     std::string path_;
     bool compressed_;
     FILE* f_ = nullptr;
     z_stream z_{};
     bool zinit_ = false;
+    bool inMember_ = false, ended_ = false, padding_ = false, gzip_ = true;
+    int members_ = 0;
     uint8_t in_[1 << 16];
 };
 
@@ -241,6 +281,7 @@ void decodePayload(VolumeGrid& g, Src src, bool bigEndian, std::vector<Piece>& p
             left -= k;
             prog.add(k);
         }
+        s.finish();
     }
     prog.finish();
     // Signed types live shifted in unsigned storage.

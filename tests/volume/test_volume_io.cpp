@@ -337,3 +337,64 @@ TEST(VolumeIO, ShippedToothNamesItsDims) {
     EXPECT_TRUE(looksLikeVolume(p));
     EXPECT_FALSE(looksLikeVolume("mesh.ply"));
 }
+
+// A gzip stream is complete only with its end marker and its CRC-32/length trailer. Cut
+// anywhere inside the deflate data or the 8-byte trailer, or with a wrong CRC or length,
+// it must be rejected, even where every voxel the header asks for was already decoded.
+TEST(VolumeIO, GzipStreamsMustEndWithAValidTrailer) {
+    std::string data(4096, '\0');
+    for (size_t i = 0; i < data.size(); ++i) data[i] = char((i * 7) ^ (i >> 5));
+    const std::string nrrdHead = "NRRD0004\ntype: uint8\nsizes: 16 16 16\nencoding: gzip\n\n";
+    const std::string niiRaw = niftiHeader(16, 16, 16, 2, 8) + data;
+    struct Case {
+        const char* ext;
+        std::string head, gz;
+    };
+    const Case cases[] = {{".nrrd", nrrdHead, gzip(data)}, {".nii.gz", "", gzip(niiRaw)}};
+    int n = 0;
+    for (const Case& c : cases) {
+        const std::string& gz = c.gz;
+        ASSERT_GT(gz.size(), 40u);
+        const VolumeGrid intact = loadVolume(writeFile("intact" + std::string(c.ext), c.head + gz), quiet());
+        EXPECT_EQ(std::memcmp(intact.bytes.data(), data.data(), data.size()), 0) << c.ext;
+        // inside the deflate data (10-byte gzip header first), then every cut of the trailer
+        std::vector<size_t> cuts = {12, gz.size() / 2, gz.size() - 10, gz.size() - 9};
+        for (size_t k = 1; k <= 8; ++k) cuts.push_back(gz.size() - k);
+        for (size_t cut : cuts) {
+            const std::string name = "cut" + std::to_string(n++) + c.ext;
+            expectError([&] { loadVolume(writeFile(name, c.head + gz.substr(0, cut)), quiet()); }, name + ": truncated");
+        }
+        // wrong CRC (first trailer byte), wrong length (last)
+        for (size_t at : {gz.size() - 8, gz.size() - 1}) {
+            std::string bad = gz;
+            bad[at] = char(bad[at] ^ 0x5A);
+            const std::string name = "badtrailer" + std::to_string(n++) + c.ext;
+            expectError([&] { loadVolume(writeFile(name, c.head + bad), quiet()); }, name + ": corrupt compressed data");
+        }
+        // Two members (as `cat a.gz b.gz` makes) and zero padding after the stream load;
+        // other bytes after it do not.
+        const size_t half = c.head.empty() ? 2000 : 2048;
+        const std::string raw = c.head.empty() ? niiRaw : data;
+        const std::string twoMembers = gzip(raw.substr(0, half)) + gzip(raw.substr(half));
+        const VolumeGrid two = loadVolume(writeFile("two" + std::string(c.ext), c.head + twoMembers), quiet());
+        EXPECT_EQ(std::memcmp(two.bytes.data(), data.data(), data.size()), 0) << c.ext;
+        EXPECT_NO_THROW(loadVolume(writeFile("padded" + std::string(c.ext), c.head + gz + std::string(100, '\0')), quiet()));
+        const std::string junk = "junk" + std::string(c.ext);
+        expectError([&] { loadVolume(writeFile(junk, c.head + gz + std::string(4, '\0') + "junk"), quiet()); }, junk + ": ");
+    }
+    // MetaImage CompressedData is a zlib stream: its Adler-32 trailer is checked the same way.
+    {
+        uLongf len = compressBound(uLong(data.size()));
+        std::string z(len, '\0');
+        ASSERT_EQ(compress2(reinterpret_cast<Bytef*>(z.data()), &len, reinterpret_cast<const Bytef*>(data.data()), uLong(data.size()), 6), Z_OK);
+        z.resize(len);
+        const std::string head = "NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\nCompressedData = True\nElementDataFile = LOCAL\n";
+        const VolumeGrid ok = loadVolume(writeFile("z.mha", head + z), quiet());
+        EXPECT_EQ(std::memcmp(ok.bytes.data(), data.data(), data.size()), 0);
+        for (size_t k = 1; k <= 4; ++k)
+            expectError([&] { loadVolume(writeFile("zcut.mha", head + z.substr(0, z.size() - k)), quiet()); }, "zcut.mha: truncated");
+        std::string bad = z;
+        bad.back() = char(bad.back() ^ 1);
+        expectError([&] { loadVolume(writeFile("zbad.mha", head + bad), quiet()); }, "zbad.mha: corrupt compressed data");
+    }
+}
