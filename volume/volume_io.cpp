@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
 #include "core/util/progress.h"
 
@@ -53,6 +54,7 @@ bool endsWith(const std::string& s, const std::string& suf) {
 }
 
 uint64_t fileSize(const std::string& path) {
+    requireRegularFile(path);
     std::error_code ec;
     const auto s = fs::file_size(path, ec);
     if (ec) throw Error(path, "cannot open file (" + ec.message() + ")");
@@ -66,6 +68,7 @@ uint64_t fileSize(const std::string& path) {
 class ByteStream {
    public:
     ByteStream(const std::string& path, uint64_t offset, bool compressed) : path_(path), compressed_(compressed) {
+        requireRegularFile(path);  // a FIFO would block fopen
         f_ = std::fopen(path.c_str(), "rb");
         if (!f_) throw Error(path, "cannot open file");
         if (fseeko(f_, off_t(offset), SEEK_SET) != 0) throw Error(path, "cannot seek to the data");
@@ -336,6 +339,7 @@ void setSpacing(VolumeGrid& g, const std::string& file, const std::vector<double
 
 // Reads a text header up to (not including) the first blank line or `limit` bytes.
 std::string readTextHead(const std::string& path, size_t limit) {
+    requireRegularFile(path);
     std::ifstream f(path, std::ios::binary);
     if (!f) throw Error(path, "cannot open file");
     std::string s(limit, '\0');
@@ -737,11 +741,10 @@ bool looksLikeVolume(const std::string& path) {
 }
 
 VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw Error(path, "no such file or directory");
+    const bool dir = requireFileOrDirectory(path);  // before any reader opens it: a FIFO would block
     const std::string p = lower(path);
     VolumeGrid g;
-    if (fs::is_directory(path, ec)) g = loadDicomSeries(path, opt);
+    if (dir) g = loadDicomSeries(path, opt);
     else if (opt.dims || !opt.type.empty()) g = loadRaw(path, opt);
     else if (endsWith(p, ".mhd") || endsWith(p, ".mha")) g = loadMetaImage(path, opt);
     else if (endsWith(p, ".nrrd") || endsWith(p, ".nhdr")) g = loadNrrd(path, opt);
@@ -768,9 +771,8 @@ VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt) {
 }
 
 BrickedVolume loadBrickedVolume(const std::string& path, const VolumeLoadOptions& opt) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw Error(path, "no such file or directory");
-    if (!fs::is_directory(path, ec) && endsWith(lower(path), ".vdb") && !opt.dims) {
+    const bool dir = requireFileOrDirectory(path);
+    if (!dir && endsWith(lower(path), ".vdb") && !opt.dims) {
         BrickedVolume v = loadVDBBricked(path, opt);
         if (opt.spacing) v.spacing = *opt.spacing;
         return v;

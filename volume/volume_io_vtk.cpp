@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "core/util/vtk_quiet.h"
 #include "volume/volume_io.h"
 
@@ -73,10 +74,14 @@ VolumeGrid fromImageData(const std::string& path, vtkImageData* img) {
 }  // namespace
 
 VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
+    requireDirectory(dir);
     std::error_code ec;
     std::vector<std::pair<fs::path, uint64_t>> slices;  // DICOM files and their sizes
     for (auto& e : fs::directory_iterator(dir, ec)) {
-        if (!e.is_regular_file() || e.path().filename() == "DICOMDIR") continue;
+        // VTK's reader opens every file of the directory: a FIFO among them would block it
+        // (dangling links are skipped, as VTK skips them).
+        if (!fs::exists(e.path(), ec)) continue;
+        if (requireFileOrDirectory(e.path().string()) || e.path().filename() == "DICOMDIR") continue;
         // DICOM part 10 files carry "DICM" at byte 128.
         std::ifstream f(e.path(), std::ios::binary);
         char pre[132] = {};
@@ -121,7 +126,9 @@ VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
 }
 
 VolumeGrid loadVTI(const std::string& path, const VolumeLoadOptions&) {
+    requireRegularFile(path);  // a FIFO would block the open
     std::ifstream f(path, std::ios::binary);
+    if (!f) throw Error(path, "cannot open file");
     std::string head(4096, '\0');
     f.read(head.data(), 4096);
     head.resize(size_t(f.gcount()));
