@@ -348,6 +348,38 @@ std::string readTextHead(const std::string& path, size_t limit) {
     return s;
 }
 
+// A modality value as DICOM spells it: "MET_MOD_CT" (MetaImage), "ct", "MR" -> "CT", "MR".
+std::string modalityTerm(std::string v) {
+    v = trim(v);
+    for (char& c : v) c = char(std::toupper((unsigned char)c));
+    if (v.rfind("MET_MOD_", 0) == 0) v = v.substr(8);
+    if (v == "MRI") v = "MR";
+    if (v == "PET") v = "PT";
+    if (v.empty() || v == "OTHER" || v == "UNKNOWN" || v.size() > 16) return "";
+    for (char c : v)
+        if (!std::isalnum((unsigned char)c)) return "";
+    return v;
+}
+// "CT" or "MR" when free text names the modality as a word ("CT scan of a bonsai tree").
+std::string modalityWord(const std::string& text) {
+    std::string word;
+    for (size_t i = 0; i <= text.size(); ++i) {
+        const char c = i < text.size() ? text[i] : ' ';
+        if (std::isalnum((unsigned char)c)) {
+            word.push_back(c);
+            continue;
+        }
+        if (word == "CT" || word == "MR" || word == "MRI") return word == "CT" ? "CT" : "MR";
+        word.clear();
+    }
+    return "";
+}
+// Free text from a fixed-size, NUL-padded header field.
+std::string headerText(const uint8_t* p, size_t n) {
+    std::string s(reinterpret_cast<const char*>(p), n);
+    return s.substr(0, s.find('\0'));
+}
+
 // ---- raw -------------------------------------------------------------------------
 
 VolumeGrid loadRaw(const std::string& path, const VolumeLoadOptions& o) {
@@ -429,6 +461,7 @@ VolumeGrid loadMetaImage(const std::string& path, const VolumeLoadOptions& o) {
     if (msb.empty()) msb = lower(get("binarydatabyteordermsb"));
     const bool big = msb == "true" || msb == "1";
     const bool compressed = lower(get("compresseddata")) == "true";
+    if (const std::string m = modalityTerm(get("modality")); !m.empty()) g.meta = {m, "MetaImage Modality"};
     const std::string df = get("elementdatafile");
     const uint64_t bytes = g.voxelCount() * uint64_t(srcBytes(src));
     std::vector<Piece> pieces;
@@ -457,6 +490,7 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
     if (head.rfind("NRRD000", 0) != 0) throw Error(path, "not a NRRD file (missing NRRD000x magic)");
     std::map<std::string, std::string> kv;
     std::vector<std::string> dataFileList;
+    std::string nrrdModality;
     size_t pos = head.find('\n');
     if (pos == std::string::npos) throw Error(path, "truncated NRRD header");
     ++pos;
@@ -479,7 +513,11 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
         if (line[0] == '#') continue;
         size_t c = line.find(": ");
         if (c == std::string::npos) {
-            if (line.find(":=") != std::string::npos) continue;  // key/value pairs: ignored
+            // key/value pairs: only a modality is used
+            if (const size_t kvp = line.find(":="); kvp != std::string::npos) {
+                if (lower(trim(line.substr(0, kvp))) == "modality") nrrdModality = line.substr(kvp + 2);
+                continue;
+            }
             throw Error(path, "bad NRRD header line '" + line.substr(0, 60) + "'");
         }
         const std::string key = lower(trim(line.substr(0, c)));
@@ -508,6 +546,8 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
     if (sizes.size() == 4 && sizes[0] == 1) sizes.erase(sizes.begin());
     VolumeGrid g;
     setDims(g, path, sizes);
+    if (const std::string m = modalityTerm(nrrdModality); !m.empty()) g.meta = {m, "NRRD modality"};
+    else if (const std::string w = modalityWord(get("content")); !w.empty()) g.meta = {w, "NRRD content"};
     if (!get("spacings").empty()) {
         std::vector<double> s;
         for (auto& w : splitWords(get("spacings")))
@@ -669,6 +709,9 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
     setSpacing(g, path, sp);
     const float vox = f32(108);
     if (!std::isfinite(vox) || vox < 348 || vox > float(fsz) * 1100.0f) throw Error(path, "bad NIfTI vox_offset");
+    // NIfTI has no modality field; its free-text descrip or aux_file may name one.
+    if (const std::string w = modalityWord(headerText(h + 148, 80)); !w.empty()) g.meta = {w, "NIfTI descrip"};
+    else if (const std::string a = modalityWord(headerText(h + 228, 24)); !a.empty()) g.meta = {a, "NIfTI aux_file"};
     const float slope = f32(112), inter = f32(116);
     if (std::isfinite(slope) && slope != 0.0f) {
         g.scale = slope;

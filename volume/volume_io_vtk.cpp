@@ -18,6 +18,7 @@
 #include "core/util/error.h"
 #include "core/util/input_file.h"
 #include "core/util/vtk_quiet.h"
+#include "volume/dicom_modality.h"
 #include "volume/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -122,6 +123,7 @@ VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
         g.scale = slope;
     }
     g.sourceType += " (DICOM, " + std::to_string(files) + " files)";
+    if (const std::string m = readDicomModality(slices.front().first.string()); !m.empty()) g.meta = {m, "DICOM modality"};
     return g;
 }
 

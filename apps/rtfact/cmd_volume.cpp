@@ -8,10 +8,12 @@
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/render_command.h"
 #include "core/util/error.h"
+#include "volume/default_transfer_function.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
+#include "volume/value_histogram.h"
 #include "volume/volume_scene.h"
 
 namespace rtfact::app {
@@ -97,7 +99,10 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                         rs.stepVoxels = o->step;
                         rs.skipping = !o->noSkip;
                         for (auto& cl : o->clips) parseClip(cl, rs);
-                        TransferFunction tf = resolveTransferFunction(o->tf.empty() ? (rs.mode == VolumeMode::MIP ? "grayscale" : "ct-bone") : o->tf);
+                        // --tf is read before the volume so that a bad file fails fast; without it
+                        // the default follows the data (chosen once the volume is loaded).
+                        std::optional<TransferFunction> given;
+                        if (!o->tf.empty()) given = resolveTransferFunction(o->tf);
                         Stats stats;
                         auto t0 = std::chrono::steady_clock::now();
                         const VolumeLoadOptions lopt = o->load.options(!c.quiet);
@@ -119,7 +124,18 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                             }
                         }
                         const auto [lo, hi] = vol.valueRange();
-                        const auto window = resolveWindow(tf, lo, hi, o->window, o->level);
+                        TransferFunction tf;
+                        std::pair<float, float> window;
+                        if (given) {
+                            tf = *given;
+                            window = resolveWindow(tf, lo, hi, o->window, o->level);
+                        } else {
+                            const DefaultTransferFunction d = chooseDefaultTransferFunction(
+                                vol.meta, histogramOf(vol), rs.mode, typicalDepthVoxels(vol.dims, vol.spacing));
+                            tf = d.tf;
+                            window = o->window || o->level ? resolveWindow(tf, lo, hi, o->window, o->level) : d.window;
+                            stats.add("tf_default", d.describe());
+                        }
                         const TFTable table = buildTable(tf, window, o->step);
                         rs.iso = o->iso ? *o->iso : (lo <= -500.0f ? 300.0f : lo + 0.4f * (hi - lo));
                         stats.add("voxels", (unsigned long long)vol.voxelCount());
@@ -197,6 +213,11 @@ std::optional<int> volumeInfo(const std::string& file) {
                 s.mean, double(g.memoryBytes()) / 1048576.0);
     for (uint64_t h : s.histogram) std::printf(" %.1f", 100.0 * double(h) / double(std::max<size_t>(g.voxelCount(), 1)));
     std::printf("\n");
+    if (!g.meta.modality.empty()) std::printf("modality: %s (%s)\n", g.meta.modality.c_str(), g.meta.modalitySource.c_str());
+    // what `rtfact volume FILE` renders with when no --tf is given
+    std::printf("tf_default: %s\n", chooseDefaultTransferFunction(g.meta, histogramOf(g), VolumeMode::DVR, typicalDepthVoxels(g.dims, g.spacing))
+                                        .describe()
+                                        .c_str());
     return 0;
 }
 

@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "core/util/error.h"
+#include "volume/dicom_modality.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_io.h"
@@ -499,4 +500,5 @@ TEST(VolumeIO, NamedPipesAreRejectedWithoutOpeningThem) {
     const std::string tf = makeFifo("pipe_tf.json");
     expectFifoRejected(tf, [&] { loadTransferFunction(tf); }, "loadTransferFunction");
     expectFifoRejected(tf, [&] { resolveTransferFunction(tf); }, "resolveTransferFunction");
+    expectFifoRejected(dpipe, [&] { readDicomModality(dpipe); }, "readDicomModality");
 }
