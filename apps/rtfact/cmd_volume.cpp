@@ -25,14 +25,30 @@ static_assert(Integrator<VolumeIntegrator, VolumeScene<float>>);
 
 namespace {
 
+// A CLI11 validator from a parser that throws rtfact::Error: bad values are bad usage
+// (exit 2, "--dims: ..."), found while parsing the command line, before any loading.
+template <class Parse>
+CLI::Validator parsedBy(Parse parse, std::string description) {
+    return CLI::Validator(
+        [parse](std::string& text) -> std::string {
+            try {
+                parse(text);
+            } catch (const Error& e) {
+                return e.what();
+            }
+            return std::string();
+        },
+        std::move(description));
+}
+
 struct LoadArgs {
     std::string dims, type, endian = "little", spacing, grid;
     uint64_t headerSkip = 0;
     void addTo(CLI::App& cmd) {
-        cmd.add_option("--dims", dims, "Raw volume size X,Y,Z");
+        cmd.add_option("--dims", dims, "Raw volume size X,Y,Z")->check(parsedBy(parseDims, "X,Y,Z"));
         cmd.add_option("--type", type, "Raw voxel type u8|u16|i16|f32")->check(CLI::IsMember({"u8", "u16", "i16", "f32"}));
         cmd.add_option("--endian", endian, "Raw byte order little|big")->capture_default_str()->check(CLI::IsMember({"little", "big"}));
-        cmd.add_option("--spacing", spacing, "Voxel spacing sx,sy,sz (overrides the file's)");
+        cmd.add_option("--spacing", spacing, "Voxel spacing sx,sy,sz (overrides the file's)")->check(parsedBy(parseSpacing, "SX,SY,SZ"));
         cmd.add_option("--header-skip", headerSkip, "Raw bytes to skip before the voxels");
         cmd.add_option("--grid", grid, "OpenVDB grid name (default: the first float grid)");
     }
@@ -85,7 +101,11 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
     cmd->add_option("--step", o->step, "Ray-marching step in voxels")->capture_default_str()->check(finiteRange(0.01, 64.0));
     cmd->add_option("--window", o->window, "Window width in data units (e.g. Hounsfield)")->check(positiveFinite());
     cmd->add_option("--level", o->level, "Window centre in data units")->check(finiteNumber());
-    cmd->add_option("--clip", o->clips, "Clip axis:lo:hi (fractions, e.g. z:0:0.5); repeatable");
+    cmd->add_option("--clip", o->clips, "Clip axis:lo:hi (fractions, e.g. z:0:0.5); repeatable")
+        ->check(parsedBy([](const std::string& c) {
+            VolumeRenderSettings s;
+            parseClip(c, s);
+        }, "AXIS:LO:HI"));
     cmd->add_flag("--no-skip", o->noSkip, "Disable empty-space skipping (for comparisons)");
     list.push_back({cmd, [o] {
                         CommonOptions& c = o->common;
