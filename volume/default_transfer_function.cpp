@@ -22,7 +22,10 @@ std::string num(float v) {
 TransferFunction histogramRamp(float m) {
     TransferFunction tf;
     tf.name = "histogram-ramp";
-    tf.colors = {{0.0f, {0.1f, 0.05f, 0.05f}}, {m, {0.6f, 0.35f, 0.25f}}, {0.5f * (m + 1.0f), {0.95f, 0.85f, 0.7f}}, {1.0f, {1, 1, 1}}};
+    tf.colors = {{0.0f, {0.1f, 0.05f, 0.05f}},
+                 {m, {0.6f, 0.35f, 0.25f}},
+                 {0.5f * (m + 1.0f), {0.95f, 0.85f, 0.7f}},
+                 {1.0f, {1, 1, 1}}};
     tf.opacity = {{0.0f, 0.0f}, {m, 0.006f}, {0.5f * (m + 1.0f), 0.025f}, {1.0f, 0.1f}};
     return tf;
 }
@@ -31,7 +34,10 @@ TransferFunction histogramRamp(float m) {
 TransferFunction histogramRampOpaque(float m) {
     TransferFunction tf;
     tf.name = "histogram-ramp-opaque";
-    tf.colors = {{0.0f, {0.55f, 0.3f, 0.2f}}, {m, {0.85f, 0.7f, 0.55f}}, {0.5f * (m + 1.0f), {0.97f, 0.92f, 0.85f}}, {1.0f, {1, 1, 1}}};
+    tf.colors = {{0.0f, {0.55f, 0.3f, 0.2f}},
+                 {m, {0.85f, 0.7f, 0.55f}},
+                 {0.5f * (m + 1.0f), {0.97f, 0.92f, 0.85f}},
+                 {1.0f, {1, 1, 1}}};
     tf.opacity = {{0.0f, 0.0f}, {0.4f * m, 0.02f}, {m, 0.25f}, {1.0f, 0.8f}};
     return tf;
 }
@@ -94,8 +100,8 @@ RampPlacement placeHistogramRamp(const ValueHistogram& h) {
     return r;
 }
 
-DefaultTransferFunction chooseDefaultTransferFunction(const VolumeMetadata& meta, const ValueHistogram& h, VolumeMode mode,
-                                                      float depthVoxels) {
+DefaultTransferFunction chooseDefaultTransferFunction(const VolumeMetadata& meta, const ValueHistogram& h,
+                                                      VolumeMode mode, float depthVoxels) {
     DefaultTransferFunction d;
     const bool mip = mode == VolumeMode::MIP;
     const bool hu = looksLikeHounsfield(h);
@@ -104,19 +110,25 @@ DefaultTransferFunction chooseDefaultTransferFunction(const VolumeMetadata& meta
     if (meta.modality == "CT" || (meta.modality.empty() && hu)) {
         d.tf = transferFunctionPreset(mip ? "grayscale" : "ct-bone");
         // the CT presets' Hounsfield window when the values are Hounsfield units, else the range
-        d.window = hu && d.tf.huWindow ? *d.tf.huWindow : std::pair<float, float>{h.lo, h.hi > h.lo ? h.hi : h.lo + 1.0f};
-        if (!stated.empty()) d.reason = stated + (hu ? "" : "; values " + range + " are not Hounsfield units: preset over the range");
-        else d.reason = "values " + range + " look like Hounsfield units: air at -1000";
+        d.window =
+            hu && d.tf.huWindow ? *d.tf.huWindow : std::pair<float, float>{h.lo, h.hi > h.lo ? h.hi : h.lo + 1.0f};
+        if (!stated.empty())
+            d.reason = stated + (hu ? "" : "; values " + range + " are not Hounsfield units: preset over the range");
+        else
+            d.reason = "values " + range + " look like Hounsfield units: air at -1000";
         if (mip) d.reason = "MIP over " + num(d.window.first) + ".." + num(d.window.second) + "; " + d.reason;
         return d;
     }
     const RampPlacement p = placeHistogramRamp(h);
     const float m = std::clamp((p.median - p.lo) / (p.hi - p.lo), 0.1f, 0.9f);
-    d.tf = mip ? transferFunctionPreset("grayscale") : mode == VolumeMode::DVR ? histogramRamp(m) : histogramRampOpaque(m);
+    d.tf = mip                       ? transferFunctionPreset("grayscale")
+           : mode == VolumeMode::DVR ? histogramRamp(m)
+                                     : histogramRampOpaque(m);
     if (!mip) scaleOpacityToDepth(d.tf, depthVoxels);
     d.window = {p.lo, p.hi};
-    d.reason = (mip ? std::string("MIP; ") : std::string()) + (stated.empty() ? std::string() : stated + "; ") + num(p.lo) + ".." +
-               num(p.hi) + " from the histogram: above the background peak at " + num(p.background) + ", up to the 99.5th percentile";
+    d.reason = (mip ? std::string("MIP; ") : std::string()) + (stated.empty() ? std::string() : stated + "; ") +
+               num(p.lo) + ".." + num(p.hi) + " from the histogram: above the background peak at " + num(p.background) +
+               ", up to the 99.5th percentile";
     return d;
 }
 

@@ -45,7 +45,8 @@ std::string parseDicomModality(const std::string& b) {
         size_t value;
         if (explicitVR) {
             const char* vr = b.data() + p + 4;
-            if (!std::isupper(static_cast<unsigned char>(vr[0])) || !std::isupper(static_cast<unsigned char>(vr[1]))) return "";
+            if (!std::isupper(static_cast<unsigned char>(vr[0])) || !std::isupper(static_cast<unsigned char>(vr[1])))
+                return "";
             if (longVR(vr)) {
                 if (p + 12 > b.size()) return "";
                 len = le32(b, p + 8);

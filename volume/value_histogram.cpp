@@ -80,7 +80,8 @@ ValueHistogram denseHistogram(const VolumeGrid& g, int maxBins) {
     const T* src = g.data<T>();
     const size_t n = g.voxelCount();
     using Range = std::pair<float, float>;
-    tbb::enumerable_thread_specific<Range> ranges(Range{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
+    tbb::enumerable_thread_specific<Range> ranges(
+        Range{std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
         Range& m = ranges.local();
         for (size_t i = r.begin(); i != r.end(); ++i) {
@@ -140,9 +141,12 @@ void brickCounts(const BrickedVolume& v, ValueHistogram& h) {
 
 ValueHistogram histogramOf(const VolumeGrid& g, int maxBins) {
     switch (g.storage) {
-        case Storage::U8: return denseHistogram<uint8_t>(g, maxBins);
-        case Storage::U16: return denseHistogram<uint16_t>(g, maxBins);
-        default: return denseHistogram<float>(g, maxBins);
+        case Storage::U8:
+            return denseHistogram<uint8_t>(g, maxBins);
+        case Storage::U16:
+            return denseHistogram<uint16_t>(g, maxBins);
+        default:
+            return denseHistogram<float>(g, maxBins);
     }
 }
 
@@ -150,9 +154,15 @@ ValueHistogram histogramOf(const BrickedVolume& v, int maxBins) {
     const auto [lo, hi] = v.valueRange();
     ValueHistogram h = emptyHistogram(lo, hi, dataStep(v.storage, v.scale), maxBins);
     switch (v.storage) {
-        case Storage::U8: brickCounts<uint8_t>(v, h); break;
-        case Storage::U16: brickCounts<uint16_t>(v, h); break;
-        default: brickCounts<float>(v, h); break;
+        case Storage::U8:
+            brickCounts<uint8_t>(v, h);
+            break;
+        case Storage::U16:
+            brickCounts<uint16_t>(v, h);
+            break;
+        default:
+            brickCounts<float>(v, h);
+            break;
     }
     return h;
 }

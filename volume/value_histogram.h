@@ -13,10 +13,10 @@
 namespace rtfact::volume {
 
 struct ValueHistogram {
-    float lo = 0, hi = 0;           // finite data range
-    float origin = 0, width = 1;    // bin i covers [origin + i * width, origin + (i + 1) * width)
+    float lo = 0, hi = 0;         // finite data range
+    float origin = 0, width = 1;  // bin i covers [origin + i * width, origin + (i + 1) * width)
     std::vector<uint64_t> bins;
-    uint64_t total = 0;             // voxels counted (finite values)
+    uint64_t total = 0;  // voxels counted (finite values)
 
     size_t binOf(float v) const;
     float binLo(size_t i) const { return origin + float(i) * width; }

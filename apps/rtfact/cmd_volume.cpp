@@ -48,7 +48,8 @@ struct LoadArgs {
         cmd.add_option("--dims", dims, "Raw volume size X,Y,Z")->check(parsedBy(parseDims, "X,Y,Z"));
         cmd.add_option("--type", type, "Raw voxel type u8|u16|i16|f32")->check(CLI::IsMember({"u8", "u16", "i16", "f32"}));
         cmd.add_option("--endian", endian, "Raw byte order little|big")->capture_default_str()->check(CLI::IsMember({"little", "big"}));
-        cmd.add_option("--spacing", spacing, "Voxel spacing sx,sy,sz (overrides the file's)")->check(parsedBy(parseSpacing, "SX,SY,SZ"));
+        cmd.add_option("--spacing", spacing, "Voxel spacing sx,sy,sz (overrides the file's)")
+            ->check(parsedBy(parseSpacing, "SX,SY,SZ"));
         cmd.add_option("--header-skip", headerSkip, "Raw bytes to skip before the voxels");
         cmd.add_option("--grid", grid, "OpenVDB grid name (default: the first float grid)");
     }
@@ -233,11 +234,12 @@ std::optional<int> volumeInfo(const std::string& file) {
                 s.mean, double(g.memoryBytes()) / 1048576.0);
     for (uint64_t h : s.histogram) std::printf(" %.1f", 100.0 * double(h) / double(std::max<size_t>(g.voxelCount(), 1)));
     std::printf("\n");
-    if (!g.meta.modality.empty()) std::printf("modality: %s (%s)\n", g.meta.modality.c_str(), g.meta.modalitySource.c_str());
+    if (!g.meta.modality.empty())
+        std::printf("modality: %s (%s)\n", g.meta.modality.c_str(), g.meta.modalitySource.c_str());
     // what `rtfact volume FILE` renders with when no --tf is given
-    std::printf("tf_default: %s\n", chooseDefaultTransferFunction(g.meta, histogramOf(g), VolumeMode::DVR, typicalDepthVoxels(g.dims, g.spacing))
-                                        .describe()
-                                        .c_str());
+    const DefaultTransferFunction d =
+        chooseDefaultTransferFunction(g.meta, histogramOf(g), VolumeMode::DVR, typicalDepthVoxels(g.dims, g.spacing));
+    std::printf("tf_default: %s\n", d.describe().c_str());
     return 0;
 }
 

@@ -60,8 +60,10 @@ VolumeGrid ctLike(int n = 40) {
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i)
-                g.data<float>()[g.index(i, j, k)] =
-                    (inBall(i, j, k, n, 0.15f * float(n)) ? 1200.0f : inBall(i, j, k, n, 0.4f * float(n)) ? 40.0f : -1000.0f) + noise(rng);
+                g.data<float>()[g.index(i, j, k)] = (inBall(i, j, k, n, 0.15f * float(n))  ? 1200.0f
+                                                     : inBall(i, j, k, n, 0.4f * float(n)) ? 40.0f
+                                                                                           : -1000.0f) +
+                                                    noise(rng);
     return g;
 }
 
@@ -76,7 +78,9 @@ VolumeGrid mrLike(int n = 48) {
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i) {
-                float v = inBall(i, j, k, n, 0.2f * float(n)) ? 500.0f : inBall(i, j, k, n, 0.35f * float(n)) ? 300.0f : 0.0f;
+                float v = inBall(i, j, k, n, 0.2f * float(n))    ? 500.0f
+                          : inBall(i, j, k, n, 0.35f * float(n)) ? 300.0f
+                                                                 : 0.0f;
                 if (v > 0) v += noise(rng);
                 g.data<uint16_t>()[g.index(i, j, k)] = uint16_t(std::max(0.0f, std::round(v)));
             }
@@ -126,7 +130,7 @@ TEST(ValueHistogram, IntegerDataGetWholeStepBins) {
     for (int i = 0; i < 200; ++i) b.bytes[size_t(i)] = uint8_t(i);
     const ValueHistogram hb = histogramOf(b);
     EXPECT_EQ(hb.bins.size(), 200u);
-    EXPECT_FLOAT_EQ(hb.percentile(0.995), 198.0f);  // 199 of the 200 values lie at or below it
+    EXPECT_FLOAT_EQ(hb.percentile(0.995), 198.0f);     // 199 of the 200 values lie at or below it
     EXPECT_FLOAT_EQ(hb.percentile(0.5, 100), 149.0f);  // the median of the values 100..199
 }
 
@@ -229,10 +233,12 @@ TEST(DefaultTransferFunction, StatedModalityWins) {
     const ValueHistogram h = histogramOf(mrLike());
     const DefaultTransferFunction ct = chooseDefaultTransferFunction({"CT", "MetaImage Modality"}, h);
     EXPECT_EQ(ct.tf.name, "ct-bone");
-    EXPECT_EQ(ct.describe(), "ct-bone (MetaImage Modality CT; values 0..4000 are not Hounsfield units: preset over the range)");
+    EXPECT_EQ(ct.describe(),
+              "ct-bone (MetaImage Modality CT; values 0..4000 are not Hounsfield units: preset over the range)");
     EXPECT_FLOAT_EQ(ct.window.first, 0.0f);
     EXPECT_FLOAT_EQ(ct.window.second, 4000.0f);
-    EXPECT_EQ(chooseDefaultTransferFunction({"CT", "DICOM modality"}, histogramOf(ctLike())).describe(), "ct-bone (DICOM modality CT)");
+    EXPECT_EQ(chooseDefaultTransferFunction({"CT", "DICOM modality"}, histogramOf(ctLike())).describe(),
+              "ct-bone (DICOM modality CT)");
 }
 
 TEST(DefaultTransferFunction, LoadersReadTheModality) {
@@ -240,16 +246,25 @@ TEST(DefaultTransferFunction, LoadersReadTheModality) {
     // MetaImage Modality
     writeFile("m.raw", voxels);
     const VolumeGrid mhd = loadVolume(
-        writeFile("m.mhd", "NDims = 3\nDimSize = 2 2 2\nModality = MET_MOD_CT\nElementType = MET_UCHAR\nElementDataFile = m.raw\n"), quiet());
+        writeFile(
+            "m.mhd",
+            "NDims = 3\nDimSize = 2 2 2\nModality = MET_MOD_CT\nElementType = MET_UCHAR\nElementDataFile = m.raw\n"),
+        quiet());
     EXPECT_EQ(mhd.meta.modality, "CT");
     EXPECT_EQ(mhd.meta.modalitySource, "MetaImage Modality");
     // NRRD: a modality key/value, or free-text content naming one
-    const VolumeGrid nk = loadVolume(writeFile("k.nrrd", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\nmodality:=MR\n\n" + voxels), quiet());
+    const VolumeGrid nk = loadVolume(
+        writeFile("k.nrrd", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\nmodality:=MR\n\n" + voxels), quiet());
     EXPECT_EQ(nk.meta.modality, "MR");
-    const VolumeGrid nc = loadVolume(writeFile("c.nrrd", "NRRD0004\ncontent: CT of a head\ntype: uint8\nsizes: 2 2 2\nencoding: raw\n\n" + voxels), quiet());
+    const VolumeGrid nc = loadVolume(
+        writeFile("c.nrrd", "NRRD0004\ncontent: CT of a head\ntype: uint8\nsizes: 2 2 2\nencoding: raw\n\n" + voxels),
+        quiet());
     EXPECT_EQ(nc.meta.modality, "CT");
     EXPECT_EQ(nc.meta.modalitySource, "NRRD content");
-    const VolumeGrid none = loadVolume(writeFile("n.nrrd", "NRRD0004\ncontent: CTA-like words, ACT\ntype: uint8\nsizes: 2 2 2\nencoding: raw\n\n" + voxels), quiet());
+    const VolumeGrid none = loadVolume(
+        writeFile("n.nrrd",
+                  "NRRD0004\ncontent: CTA-like words, ACT\ntype: uint8\nsizes: 2 2 2\nencoding: raw\n\n" + voxels),
+        quiet());
     EXPECT_EQ(none.meta.modality, "");
     // NIfTI: descrip
     std::string nii(352, '\0');
@@ -283,7 +298,8 @@ TEST(DefaultTransferFunction, DicomModalityFromExplicitAndImplicitVR) {
     };
     for (bool explicitVR : {true, false}) {
         std::string f = std::string(128, '\0') + "DICM";
-        f += element(0x0002, 0x0010, "UI", explicitVR ? "1.2.840.10008.1.2.1\0" : std::string("1.2.840.10008.1.2\0", 18), true);
+        f += element(0x0002, 0x0010, "UI",
+                     explicitVR ? "1.2.840.10008.1.2.1\0" : std::string("1.2.840.10008.1.2\0", 18), true);
         f += element(0x0008, 0x0020, "DA", "20260101", explicitVR);
         f += element(0x0008, 0x0060, "CS", "CT", explicitVR);
         EXPECT_EQ(parseDicomModality(f), "CT") << explicitVR;
@@ -372,7 +388,8 @@ TEST(DefaultTransferFunction, LookCheckRejectsBlobsAndSpeckle) {
         for (int x = 0; x < 64; ++x) {
             float* p = &disc.rgba[size_t(y * 64 + x) * 4];
             if ((x - 32) * (x - 32) + (y - 32) * (y - 32) < 400) p[0] = p[1] = p[2] = p[3] = 0.8f;
-            if (x % 9 == 0 && y % 9 == 0) std::fill(&dots.rgba[size_t(y * 64 + x) * 4], &dots.rgba[size_t(y * 64 + x) * 4] + 4, 1.0f);
+            if (x % 9 == 0 && y % 9 == 0)
+                std::fill(&dots.rgba[size_t(y * 64 + x) * 4], &dots.rgba[size_t(y * 64 + x) * 4] + 4, 1.0f);
         }
     EXPECT_GT(look(disc).coverage, 0.2);
     EXPECT_FALSE(looksRight(look(disc)));
@@ -402,10 +419,12 @@ TEST(DefaultTransferFunction, SyntheticMriIsNoLongerSpeckle) {
 TEST(DefaultTransferFunction, RealMriRendersWithStructure) {
     const std::string d = std::string(RTFACT_SHARED_DATA) + "/volumes";
     if (!fs::exists(d)) GTEST_SKIP() << "shared datasets not present at " << d;
-    for (const char* name : {"chris_t1_mri.nii.gz", "colin27_ch2_t1.nii.gz", "dicom_mr_t1_vs_seg_001", "head_mr_small_mhd/HeadMRVolume.mhd"}) {
+    for (const char* name : {"chris_t1_mri.nii.gz", "colin27_ch2_t1.nii.gz", "dicom_mr_t1_vs_seg_001",
+                             "head_mr_small_mhd/HeadMRVolume.mhd"}) {
         VolumeGrid g = loadVolume(d + "/" + name, quiet());
         const ValueHistogram h = histogramOf(g);
-        const DefaultTransferFunction def = chooseDefaultTransferFunction(g.meta, h, VolumeMode::DVR, typicalDepthVoxels(g.dims, g.spacing));
+        const DefaultTransferFunction def =
+            chooseDefaultTransferFunction(g.meta, h, VolumeMode::DVR, typicalDepthVoxels(g.dims, g.spacing));
         EXPECT_EQ(def.tf.name, "histogram-ramp") << name << ": " << def.describe();
         EXPECT_GT(def.window.first, placeHistogramRamp(h).background) << name;
         EXPECT_LT(def.window.second, h.hi * 0.95f) << name;  // a few hot voxels do not set the top
@@ -426,7 +445,8 @@ TEST(DefaultTransferFunction, RampStartStopsWhereThereIsNoValley) {
     g.allocate(Storage::U8);
     std::mt19937 rng(11);
     std::exponential_distribution<float> tissue(1.0f / 40.0f);
-    for (size_t i = 0; i < g.voxelCount(); ++i) g.bytes[i] = i % 3 == 0 ? 0 : uint8_t(std::min(255.0f, 1.0f + tissue(rng)));
+    for (size_t i = 0; i < g.voxelCount(); ++i)
+        g.bytes[i] = i % 3 == 0 ? 0 : uint8_t(std::min(255.0f, 1.0f + tissue(rng)));
     const ValueHistogram h = histogramOf(g);
     const RampPlacement p = placeHistogramRamp(h);
     EXPECT_LT(p.background, 1.0f);
