@@ -131,6 +131,7 @@ BrickedVolume brickVolume(VolumeGrid& g, bool release) {
     v.scale = g.scale;
     v.offset = g.offset;
     v.sourceType = g.sourceType;
+    v.meta = g.meta;
     switch (g.storage) {
         case Storage::U8: brickDense<uint8_t>(g, v, release); break;
         case Storage::U16: brickDense<uint16_t>(g, v, release); break;

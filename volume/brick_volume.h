@@ -28,6 +28,7 @@ struct BrickedVolume {
     Storage storage = Storage::U8;
     float scale = 1.0f, offset = 0.0f;
     std::string sourceType;
+    VolumeMetadata meta;
     std::vector<uint8_t> pool;            // bricks of kBrick samples; brick 0 is all zero
     std::vector<int32_t> brickStart;      // per brick: first sample in the pool
     std::vector<float> cellLo, cellHi;    // per brick: stored min/max

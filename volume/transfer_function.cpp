@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 
 namespace rtfact::volume {
 
@@ -174,6 +175,7 @@ TransferFunction parseTransferFunctionJson(const std::string& text, const std::s
 }
 
 TransferFunction loadTransferFunction(const std::string& path) {
+    requireRegularFile(path);  // a FIFO would block the open
     std::ifstream f(path, std::ios::binary);
     if (!f) throw Error(path, "cannot open transfer function file");
     f.seekg(0, std::ios::end);

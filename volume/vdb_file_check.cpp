@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 
 namespace rtfact::volume {
 
@@ -310,6 +311,7 @@ class TreeWalk {
 }  // namespace
 
 void checkVdbFile(const std::string& path) {
+    requireRegularFile(path);  // a FIFO would block the open
     Reader r(path);
     // Archive::readHeader
     if (r.size() < 8 || r.get<int64_t>("magic number") != kMagic) throw Error(path, "not an OpenVDB file (bad magic number)");

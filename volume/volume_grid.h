@@ -13,6 +13,12 @@ namespace rtfact::volume {
 
 enum class Storage { U8, U16, F32 };
 
+// What the file says about the acquisition, used to choose defaults (transfer function).
+struct VolumeMetadata {
+    std::string modality;        // DICOM terms, upper case: "CT", "MR", "PT", ...; empty when unknown
+    std::string modalitySource;  // where it was read, e.g. "DICOM modality", "MetaImage Modality"
+};
+
 inline const char* storageName(Storage s) { return s == Storage::U8 ? "u8" : (s == Storage::U16 ? "u16" : "f32"); }
 inline int storageBytes(Storage s) { return s == Storage::U8 ? 1 : (s == Storage::U16 ? 2 : 4); }
 
@@ -23,6 +29,7 @@ struct VolumeGrid {
     Storage storage = Storage::U8;
     std::string sourceType;  // type in the file (u8, i16, f64, ...)
     float scale = 1.0f, offset = 0.0f;  // data value = stored * scale + offset
+    VolumeMetadata meta;
     // Stored voxels, x fastest, plus kPad bytes so wide gathers may over-read.
     std::vector<uint8_t> bytes;
     static constexpr size_t kPad = 16;

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
 #include "core/util/progress.h"
 
@@ -53,16 +54,21 @@ bool endsWith(const std::string& s, const std::string& suf) {
 }
 
 uint64_t fileSize(const std::string& path) {
+    requireRegularFile(path);
     std::error_code ec;
     const auto s = fs::file_size(path, ec);
     if (ec) throw Error(path, "cannot open file (" + ec.message() + ")");
     return s;
 }
 
-// Sequential bytes from a file at an offset, raw or zlib/gzip compressed.
+// Sequential bytes from a file at an offset, raw or zlib/gzip compressed. A compressed
+// stream is only complete once zlib has seen its end and checked its trailer (CRC-32 and
+// length for gzip, Adler-32 for zlib): finish() decodes up to there, so a stream cut after
+// the bytes a header asks for is an error rather than a silent success.
 class ByteStream {
    public:
     ByteStream(const std::string& path, uint64_t offset, bool compressed) : path_(path), compressed_(compressed) {
+        requireRegularFile(path);  // a FIFO would block fopen
         f_ = std::fopen(path.c_str(), "rb");
         if (!f_) throw Error(path, "cannot open file");
         if (fseeko(f_, off_t(offset), SEEK_SET) != 0) throw Error(path, "cannot seek to the data");
@@ -94,38 +100,75 @@ class ByteStream {
             n -= k;
         }
     }
+    // Compressed: decodes (and drops) the rest of the stream, checking every member's
+    // trailer; throws when the file ends inside a member.
+    void finish() {
+        if (!compressed_) return;
+        std::vector<uint8_t> tmp(1 << 16);
+        while (readSome(tmp.data(), tmp.size()) == tmp.size()) {
+        }
+    }
 
    private:
     size_t readSome(uint8_t* dst, size_t n) {
         if (!compressed_) return std::fread(dst, 1, n, f_);
         z_.next_out = dst;
         z_.avail_out = uInt(n);
-        size_t done = 0;
-        while (z_.avail_out > 0) {
-            if (z_.avail_in == 0) {
-                const size_t k = std::fread(in_, 1, sizeof(in_), f_);
-                if (k == 0) break;
-                z_.next_in = in_;
-                z_.avail_in = uInt(k);
-            }
-            const int r = inflate(&z_, Z_NO_FLUSH);
-            if (r == Z_STREAM_END) {
-                // Concatenated gzip members: continue with the next one.
-                if (z_.avail_in == 0 && std::feof(f_)) break;
-                if (inflateReset(&z_) != Z_OK) break;
-                continue;
-            }
-            if (r != Z_OK && r != Z_BUF_ERROR) throw Error(path_, std::string("corrupt compressed data (zlib: ") + (z_.msg ? z_.msg : "error") + ")");
-            if (r == Z_BUF_ERROR && z_.avail_in == 0 && std::feof(f_)) break;
-        }
-        done = n - z_.avail_out;
-        return done;
+        while (z_.avail_out > 0 && !ended_) step();
+        return n - z_.avail_out;
     }
+    // One inflate call (or the input it needs). Ends cleanly only at the end of the file
+    // after a complete member (optionally followed by zero padding, as gzip -d accepts).
+    void step() {
+        if (z_.avail_in == 0) {
+            const size_t k = std::fread(in_, 1, sizeof(in_), f_);
+            if (k == 0) {
+                if (std::ferror(f_)) throw Error(path_, "read error in compressed data");
+                if (inMember_)
+                    throw Error(path_, "truncated compressed data: the file ends before the end of the " + format() +
+                                           " stream and its " + trailer() + " trailer");
+                ended_ = true;
+                return;
+            }
+            z_.next_in = in_;
+            z_.avail_in = uInt(k);
+        }
+        if (!inMember_ && members_ > 0) {
+            // after a complete member: zero padding to the end of the file, or another member
+            while (z_.avail_in > 0 && *z_.next_in == 0) {
+                ++z_.next_in;
+                --z_.avail_in;
+                padding_ = true;
+            }
+            if (z_.avail_in == 0) return;
+            if (padding_) throw Error(path_, "unexpected bytes after the end of the compressed data");
+            if (inflateReset(&z_) != Z_OK) throw Error(path_, "cannot reset zlib");
+        }
+        if (!inMember_) gzip_ = z_.avail_in >= 2 && z_.next_in[0] == 0x1f && z_.next_in[1] == 0x8b;
+        inMember_ = true;
+        const uInt before = z_.avail_in;
+        const int r = inflate(&z_, Z_NO_FLUSH);
+        if (r == Z_STREAM_END) {
+            inMember_ = false;
+            ++members_;
+            return;
+        }
+        if (r == Z_OK || (r == Z_BUF_ERROR && (z_.avail_in == 0 || z_.avail_in != before))) return;
+        const std::string msg = z_.msg ? z_.msg : "error " + std::to_string(r);
+        if (msg == "incorrect data check" || msg == "incorrect length check")
+            throw Error(path_, "corrupt compressed data: " + trailer() + " trailer does not match the data (zlib: " + msg + ")");
+        throw Error(path_, "corrupt compressed data (zlib: " + msg + ")");
+    }
+    std::string format() const { return gzip_ ? "gzip" : "zlib"; }
+    std::string trailer() const { return gzip_ ? "CRC-32/length" : "Adler-32"; }
+
     std::string path_;
     bool compressed_;
     FILE* f_ = nullptr;
     z_stream z_{};
     bool zinit_ = false;
+    bool inMember_ = false, ended_ = false, padding_ = false, gzip_ = true;
+    int members_ = 0;
     uint8_t in_[1 << 16];
 };
 
@@ -241,6 +284,7 @@ void decodePayload(VolumeGrid& g, Src src, bool bigEndian, std::vector<Piece>& p
             left -= k;
             prog.add(k);
         }
+        s.finish();
     }
     prog.finish();
     // Signed types live shifted in unsigned storage.
@@ -295,12 +339,45 @@ void setSpacing(VolumeGrid& g, const std::string& file, const std::vector<double
 
 // Reads a text header up to (not including) the first blank line or `limit` bytes.
 std::string readTextHead(const std::string& path, size_t limit) {
+    requireRegularFile(path);
     std::ifstream f(path, std::ios::binary);
     if (!f) throw Error(path, "cannot open file");
     std::string s(limit, '\0');
     f.read(s.data(), std::streamsize(limit));
     s.resize(size_t(f.gcount()));
     return s;
+}
+
+// A modality value as DICOM spells it: "MET_MOD_CT" (MetaImage), "ct", "MR" -> "CT", "MR".
+std::string modalityTerm(std::string v) {
+    v = trim(v);
+    for (char& c : v) c = char(std::toupper((unsigned char)c));
+    if (v.rfind("MET_MOD_", 0) == 0) v = v.substr(8);
+    if (v == "MRI") v = "MR";
+    if (v == "PET") v = "PT";
+    if (v.empty() || v == "OTHER" || v == "UNKNOWN" || v.size() > 16) return "";
+    for (char c : v)
+        if (!std::isalnum((unsigned char)c)) return "";
+    return v;
+}
+// "CT" or "MR" when free text names the modality as a word ("CT scan of a bonsai tree").
+std::string modalityWord(const std::string& text) {
+    std::string word;
+    for (size_t i = 0; i <= text.size(); ++i) {
+        const char c = i < text.size() ? text[i] : ' ';
+        if (std::isalnum((unsigned char)c)) {
+            word.push_back(c);
+            continue;
+        }
+        if (word == "CT" || word == "MR" || word == "MRI") return word == "CT" ? "CT" : "MR";
+        word.clear();
+    }
+    return "";
+}
+// Free text from a fixed-size, NUL-padded header field.
+std::string headerText(const uint8_t* p, size_t n) {
+    std::string s(reinterpret_cast<const char*>(p), n);
+    return s.substr(0, s.find('\0'));
 }
 
 // ---- raw -------------------------------------------------------------------------
@@ -384,6 +461,7 @@ VolumeGrid loadMetaImage(const std::string& path, const VolumeLoadOptions& o) {
     if (msb.empty()) msb = lower(get("binarydatabyteordermsb"));
     const bool big = msb == "true" || msb == "1";
     const bool compressed = lower(get("compresseddata")) == "true";
+    if (const std::string m = modalityTerm(get("modality")); !m.empty()) g.meta = {m, "MetaImage Modality"};
     const std::string df = get("elementdatafile");
     const uint64_t bytes = g.voxelCount() * uint64_t(srcBytes(src));
     std::vector<Piece> pieces;
@@ -412,6 +490,7 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
     if (head.rfind("NRRD000", 0) != 0) throw Error(path, "not a NRRD file (missing NRRD000x magic)");
     std::map<std::string, std::string> kv;
     std::vector<std::string> dataFileList;
+    std::string nrrdModality;
     size_t pos = head.find('\n');
     if (pos == std::string::npos) throw Error(path, "truncated NRRD header");
     ++pos;
@@ -434,7 +513,11 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
         if (line[0] == '#') continue;
         size_t c = line.find(": ");
         if (c == std::string::npos) {
-            if (line.find(":=") != std::string::npos) continue;  // key/value pairs: ignored
+            // key/value pairs: only a modality is used
+            if (const size_t kvp = line.find(":="); kvp != std::string::npos) {
+                if (lower(trim(line.substr(0, kvp))) == "modality") nrrdModality = line.substr(kvp + 2);
+                continue;
+            }
             throw Error(path, "bad NRRD header line '" + line.substr(0, 60) + "'");
         }
         const std::string key = lower(trim(line.substr(0, c)));
@@ -463,6 +546,8 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
     if (sizes.size() == 4 && sizes[0] == 1) sizes.erase(sizes.begin());
     VolumeGrid g;
     setDims(g, path, sizes);
+    if (const std::string m = modalityTerm(nrrdModality); !m.empty()) g.meta = {m, "NRRD modality"};
+    else if (const std::string w = modalityWord(get("content")); !w.empty()) g.meta = {w, "NRRD content"};
     if (!get("spacings").empty()) {
         std::vector<double> s;
         for (auto& w : splitWords(get("spacings")))
@@ -624,6 +709,9 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
     setSpacing(g, path, sp);
     const float vox = f32(108);
     if (!std::isfinite(vox) || vox < 348 || vox > float(fsz) * 1100.0f) throw Error(path, "bad NIfTI vox_offset");
+    // NIfTI has no modality field; its free-text descrip or aux_file may name one.
+    if (const std::string w = modalityWord(headerText(h + 148, 80)); !w.empty()) g.meta = {w, "NIfTI descrip"};
+    else if (const std::string a = modalityWord(headerText(h + 228, 24)); !a.empty()) g.meta = {a, "NIfTI aux_file"};
     const float slope = f32(112), inter = f32(116);
     if (std::isfinite(slope) && slope != 0.0f) {
         g.scale = slope;
@@ -696,11 +784,10 @@ bool looksLikeVolume(const std::string& path) {
 }
 
 VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw Error(path, "no such file or directory");
+    const bool dir = requireFileOrDirectory(path);  // before any reader opens it: a FIFO would block
     const std::string p = lower(path);
     VolumeGrid g;
-    if (fs::is_directory(path, ec)) g = loadDicomSeries(path, opt);
+    if (dir) g = loadDicomSeries(path, opt);
     else if (opt.dims || !opt.type.empty()) g = loadRaw(path, opt);
     else if (endsWith(p, ".mhd") || endsWith(p, ".mha")) g = loadMetaImage(path, opt);
     else if (endsWith(p, ".nrrd") || endsWith(p, ".nhdr")) g = loadNrrd(path, opt);
@@ -727,9 +814,8 @@ VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt) {
 }
 
 BrickedVolume loadBrickedVolume(const std::string& path, const VolumeLoadOptions& opt) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw Error(path, "no such file or directory");
-    if (!fs::is_directory(path, ec) && endsWith(lower(path), ".vdb") && !opt.dims) {
+    const bool dir = requireFileOrDirectory(path);
+    if (!dir && endsWith(lower(path), ".vdb") && !opt.dims) {
         BrickedVolume v = loadVDBBricked(path, opt);
         if (opt.spacing) v.spacing = *opt.spacing;
         return v;

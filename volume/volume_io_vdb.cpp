@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "volume/vdb_file_check.h"
 #include "volume/volume_io.h"
 
@@ -21,6 +22,7 @@ namespace {
 // (vdb_file_check.h) has passed: OpenVDB trusts the lengths and counts in the file and, on a
 // truncated or corrupted one, reads past its end, allocates by garbage lengths or stalls.
 openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const VolumeLoadOptions& opt, std::string& name) {
+    requireRegularFile(path);  // a FIFO would block the open
     checkVdbFile(path);
     openvdb::initialize();
     openvdb::FloatGrid::Ptr grid;

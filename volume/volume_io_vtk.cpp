@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "core/util/vtk_quiet.h"
+#include "volume/dicom_modality.h"
 #include "volume/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -73,10 +75,14 @@ VolumeGrid fromImageData(const std::string& path, vtkImageData* img) {
 }  // namespace
 
 VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
+    requireDirectory(dir);
     std::error_code ec;
     std::vector<std::pair<fs::path, uint64_t>> slices;  // DICOM files and their sizes
     for (auto& e : fs::directory_iterator(dir, ec)) {
-        if (!e.is_regular_file() || e.path().filename() == "DICOMDIR") continue;
+        // VTK's reader opens every file of the directory: a FIFO among them would block it
+        // (dangling links are skipped, as VTK skips them).
+        if (!fs::exists(e.path(), ec)) continue;
+        if (requireFileOrDirectory(e.path().string()) || e.path().filename() == "DICOMDIR") continue;
         // DICOM part 10 files carry "DICM" at byte 128.
         std::ifstream f(e.path(), std::ios::binary);
         char pre[132] = {};
@@ -117,11 +123,14 @@ VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
         g.scale = slope;
     }
     g.sourceType += " (DICOM, " + std::to_string(files) + " files)";
+    if (const std::string m = readDicomModality(slices.front().first.string()); !m.empty()) g.meta = {m, "DICOM modality"};
     return g;
 }
 
 VolumeGrid loadVTI(const std::string& path, const VolumeLoadOptions&) {
+    requireRegularFile(path);  // a FIFO would block the open
     std::ifstream f(path, std::ios::binary);
+    if (!f) throw Error(path, "cannot open file");
     std::string head(4096, '\0');
     f.read(head.data(), 4096);
     head.resize(size_t(f.gcount()));

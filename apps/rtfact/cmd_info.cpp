@@ -1,8 +1,7 @@
 // `rtfact info FILE`: what a file holds, asked of each domain in turn.
-#include <filesystem>
-
 #include "apps/rtfact/commands.h"
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 
 namespace rtfact::app {
 
@@ -11,8 +10,8 @@ void addInfoCommand(CLI::App& app, CommandList& list) {
     CLI::App* cmd = app.add_subcommand("info", "Print what a mesh, point cloud or volume file holds");
     cmd->add_option("FILE", *file, "Input file (or DICOM directory)")->required();
     list.push_back({cmd, [file] {
-                        std::error_code ec;
-                        if (!std::filesystem::exists(*file, ec)) throw Error(*file, "no such file or directory");
+                        // Before any domain opens it: a named pipe would block every reader.
+                        requireFileOrDirectory(*file);
                         if (auto r = volumeInfo(*file)) return *r;
                         if (auto r = meshInfo(*file)) return *r;
                         if (auto r = pointsInfo(*file)) return *r;

@@ -8,10 +8,12 @@
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/render_command.h"
 #include "core/util/error.h"
+#include "volume/default_transfer_function.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
+#include "volume/value_histogram.h"
 #include "volume/volume_scene.h"
 
 namespace rtfact::app {
@@ -23,14 +25,31 @@ static_assert(Integrator<VolumeIntegrator, VolumeScene<float>>);
 
 namespace {
 
+// A CLI11 validator from a parser that throws rtfact::Error: bad values are bad usage
+// (exit 2, "--dims: ..."), found while parsing the command line, before any loading.
+template <class Parse>
+CLI::Validator parsedBy(Parse parse, std::string description) {
+    return CLI::Validator(
+        [parse](std::string& text) -> std::string {
+            try {
+                parse(text);
+            } catch (const Error& e) {
+                return e.what();
+            }
+            return std::string();
+        },
+        std::move(description));
+}
+
 struct LoadArgs {
     std::string dims, type, endian = "little", spacing, grid;
     uint64_t headerSkip = 0;
     void addTo(CLI::App& cmd) {
-        cmd.add_option("--dims", dims, "Raw volume size X,Y,Z");
+        cmd.add_option("--dims", dims, "Raw volume size X,Y,Z")->check(parsedBy(parseDims, "X,Y,Z"));
         cmd.add_option("--type", type, "Raw voxel type u8|u16|i16|f32")->check(CLI::IsMember({"u8", "u16", "i16", "f32"}));
         cmd.add_option("--endian", endian, "Raw byte order little|big")->capture_default_str()->check(CLI::IsMember({"little", "big"}));
-        cmd.add_option("--spacing", spacing, "Voxel spacing sx,sy,sz (overrides the file's)");
+        cmd.add_option("--spacing", spacing, "Voxel spacing sx,sy,sz (overrides the file's)")
+            ->check(parsedBy(parseSpacing, "SX,SY,SZ"));
         cmd.add_option("--header-skip", headerSkip, "Raw bytes to skip before the voxels");
         cmd.add_option("--grid", grid, "OpenVDB grid name (default: the first float grid)");
     }
@@ -83,7 +102,11 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
     cmd->add_option("--step", o->step, "Ray-marching step in voxels")->capture_default_str()->check(finiteRange(0.01, 64.0));
     cmd->add_option("--window", o->window, "Window width in data units (e.g. Hounsfield)")->check(positiveFinite());
     cmd->add_option("--level", o->level, "Window centre in data units")->check(finiteNumber());
-    cmd->add_option("--clip", o->clips, "Clip axis:lo:hi (fractions, e.g. z:0:0.5); repeatable");
+    cmd->add_option("--clip", o->clips, "Clip axis:lo:hi (fractions, e.g. z:0:0.5); repeatable")
+        ->check(parsedBy([](const std::string& c) {
+            VolumeRenderSettings s;
+            parseClip(c, s);
+        }, "AXIS:LO:HI"));
     cmd->add_flag("--no-skip", o->noSkip, "Disable empty-space skipping (for comparisons)");
     list.push_back({cmd, [o] {
                         CommonOptions& c = o->common;
@@ -97,7 +120,10 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                         rs.stepVoxels = o->step;
                         rs.skipping = !o->noSkip;
                         for (auto& cl : o->clips) parseClip(cl, rs);
-                        TransferFunction tf = resolveTransferFunction(o->tf.empty() ? (rs.mode == VolumeMode::MIP ? "grayscale" : "ct-bone") : o->tf);
+                        // --tf is read before the volume so that a bad file fails fast; without it
+                        // the default follows the data (chosen once the volume is loaded).
+                        std::optional<TransferFunction> given;
+                        if (!o->tf.empty()) given = resolveTransferFunction(o->tf);
                         Stats stats;
                         auto t0 = std::chrono::steady_clock::now();
                         const VolumeLoadOptions lopt = o->load.options(!c.quiet);
@@ -119,7 +145,18 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                             }
                         }
                         const auto [lo, hi] = vol.valueRange();
-                        const auto window = resolveWindow(tf, lo, hi, o->window, o->level);
+                        TransferFunction tf;
+                        std::pair<float, float> window;
+                        if (given) {
+                            tf = *given;
+                            window = resolveWindow(tf, lo, hi, o->window, o->level);
+                        } else {
+                            const DefaultTransferFunction d = chooseDefaultTransferFunction(
+                                vol.meta, histogramOf(vol), rs.mode, typicalDepthVoxels(vol.dims, vol.spacing));
+                            tf = d.tf;
+                            window = o->window || o->level ? resolveWindow(tf, lo, hi, o->window, o->level) : d.window;
+                            stats.add("tf_default", d.describe());
+                        }
                         const TFTable table = buildTable(tf, window, o->step);
                         rs.iso = o->iso ? *o->iso : (lo <= -500.0f ? 300.0f : lo + 0.4f * (hi - lo));
                         stats.add("voxels", (unsigned long long)vol.voxelCount());
@@ -197,6 +234,12 @@ std::optional<int> volumeInfo(const std::string& file) {
                 s.mean, double(g.memoryBytes()) / 1048576.0);
     for (uint64_t h : s.histogram) std::printf(" %.1f", 100.0 * double(h) / double(std::max<size_t>(g.voxelCount(), 1)));
     std::printf("\n");
+    if (!g.meta.modality.empty())
+        std::printf("modality: %s (%s)\n", g.meta.modality.c_str(), g.meta.modalitySource.c_str());
+    // what `rtfact volume FILE` renders with when no --tf is given
+    const DefaultTransferFunction d =
+        chooseDefaultTransferFunction(g.meta, histogramOf(g), VolumeMode::DVR, typicalDepthVoxels(g.dims, g.spacing));
+    std::printf("tf_default: %s\n", d.describe().c_str());
     return 0;
 }
 

@@ -1,18 +1,26 @@
 // Loaders: formats round-trip, real data (skipped when /work/shared/datasets is absent),
 // and hostile inputs giving a one-line rtfact::Error instead of a crash or a huge
 // allocation.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <thread>
 
 #include "core/util/error.h"
+#include "volume/dicom_modality.h"
+#include "volume/transfer_function.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_io.h"
 
@@ -329,11 +337,168 @@ TEST(VolumeIO, RealDatasets) {
 
 TEST(VolumeIO, ShippedToothNamesItsDims) {
     const std::string p = std::string(RTFACT_DATASETS) + "/volumes/tooth_103x94x161_uint8.raw";
-    if (!fs::exists(p)) GTEST_SKIP() << "missing " << p;
+    ASSERT_TRUE(fs::exists(p)) << "tracked dataset missing: " << p;  // tracked data is never optional
     const VolumeGrid g = loadVolume(p, quiet());
     EXPECT_EQ(g.dims[0], 103);
     EXPECT_EQ(g.dims[1], 94);
     EXPECT_EQ(g.dims[2], 161);
     EXPECT_TRUE(looksLikeVolume(p));
     EXPECT_FALSE(looksLikeVolume("mesh.ply"));
+}
+
+// A gzip stream is complete only with its end marker and its CRC-32/length trailer. Cut
+// anywhere inside the deflate data or the 8-byte trailer, or with a wrong CRC or length,
+// it must be rejected, even where every voxel the header asks for was already decoded.
+TEST(VolumeIO, GzipStreamsMustEndWithAValidTrailer) {
+    std::string data(4096, '\0');
+    for (size_t i = 0; i < data.size(); ++i) data[i] = char((i * 7) ^ (i >> 5));
+    const std::string nrrdHead = "NRRD0004\ntype: uint8\nsizes: 16 16 16\nencoding: gzip\n\n";
+    const std::string niiRaw = niftiHeader(16, 16, 16, 2, 8) + data;
+    struct Case {
+        const char* ext;
+        std::string head, gz;
+    };
+    const Case cases[] = {{".nrrd", nrrdHead, gzip(data)}, {".nii.gz", "", gzip(niiRaw)}};
+    int n = 0;
+    for (const Case& c : cases) {
+        const std::string& gz = c.gz;
+        ASSERT_GT(gz.size(), 40u);
+        const VolumeGrid intact = loadVolume(writeFile("intact" + std::string(c.ext), c.head + gz), quiet());
+        EXPECT_EQ(std::memcmp(intact.bytes.data(), data.data(), data.size()), 0) << c.ext;
+        // inside the deflate data (10-byte gzip header first), then every cut of the trailer
+        std::vector<size_t> cuts = {12, gz.size() / 2, gz.size() - 10, gz.size() - 9};
+        for (size_t k = 1; k <= 8; ++k) cuts.push_back(gz.size() - k);
+        for (size_t cut : cuts) {
+            const std::string name = "cut" + std::to_string(n++) + c.ext;
+            expectError([&] { loadVolume(writeFile(name, c.head + gz.substr(0, cut)), quiet()); }, name + ": truncated");
+        }
+        // wrong CRC (first trailer byte), wrong length (last)
+        for (size_t at : {gz.size() - 8, gz.size() - 1}) {
+            std::string bad = gz;
+            bad[at] = char(bad[at] ^ 0x5A);
+            const std::string name = "badtrailer" + std::to_string(n++) + c.ext;
+            expectError([&] { loadVolume(writeFile(name, c.head + bad), quiet()); }, name + ": corrupt compressed data");
+        }
+        // Two members (as `cat a.gz b.gz` makes) and zero padding after the stream load;
+        // other bytes after it do not.
+        const size_t half = c.head.empty() ? 2000 : 2048;
+        const std::string raw = c.head.empty() ? niiRaw : data;
+        const std::string twoMembers = gzip(raw.substr(0, half)) + gzip(raw.substr(half));
+        const VolumeGrid two = loadVolume(writeFile("two" + std::string(c.ext), c.head + twoMembers), quiet());
+        EXPECT_EQ(std::memcmp(two.bytes.data(), data.data(), data.size()), 0) << c.ext;
+        EXPECT_NO_THROW(loadVolume(writeFile("padded" + std::string(c.ext), c.head + gz + std::string(100, '\0')), quiet()));
+        const std::string junk = "junk" + std::string(c.ext);
+        expectError([&] { loadVolume(writeFile(junk, c.head + gz + std::string(4, '\0') + "junk"), quiet()); }, junk + ": ");
+    }
+    // MetaImage CompressedData is a zlib stream: its Adler-32 trailer is checked the same way.
+    {
+        uLongf len = compressBound(uLong(data.size()));
+        std::string z(len, '\0');
+        ASSERT_EQ(compress2(reinterpret_cast<Bytef*>(z.data()), &len, reinterpret_cast<const Bytef*>(data.data()), uLong(data.size()), 6), Z_OK);
+        z.resize(len);
+        const std::string head = "NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\nCompressedData = True\nElementDataFile = LOCAL\n";
+        const VolumeGrid ok = loadVolume(writeFile("z.mha", head + z), quiet());
+        EXPECT_EQ(std::memcmp(ok.bytes.data(), data.data(), data.size()), 0);
+        for (size_t k = 1; k <= 4; ++k)
+            expectError([&] { loadVolume(writeFile("zcut.mha", head + z.substr(0, z.size() - k)), quiet()); }, "zcut.mha: truncated");
+        std::string bad = z;
+        bad.back() = char(bad.back() ^ 1);
+        expectError([&] { loadVolume(writeFile("zbad.mha", head + bad), quiet()); }, "zbad.mha: corrupt compressed data");
+    }
+}
+
+namespace {
+
+// Runs f, which must reject the FIFO at `fifo` with a one-line rtfact::Error naming it,
+// without opening it. Should f open it anyway (the bug: the open blocks until a writer
+// comes), the watcher opens the write end, so the reader gets end of file instead of
+// hanging the test, and records that it did.
+void expectFifoRejected(const std::string& fifo, const std::function<void()>& f, const std::string& what) {
+    std::atomic<bool> done{false}, opened{false};
+    std::thread watcher([&] {
+        while (!done) {
+            const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);  // succeeds only while a reader has it open
+            if (fd >= 0) {
+                opened = true;
+                ::close(fd);
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+    });
+    try {
+        f();
+        ADD_FAILURE() << what << ": no error for the named pipe " << fifo;
+    } catch (const Error& e) {
+        EXPECT_EQ(e.file(), fifo) << what << ": " << e.message();
+        EXPECT_NE(e.message().find("named pipe"), std::string::npos) << what << ": " << e.message();
+        EXPECT_EQ(e.message().find('\n'), std::string::npos) << what << ": " << e.message();
+    }
+    done = true;
+    watcher.join();
+    EXPECT_FALSE(opened) << what << ": opened the named pipe";
+}
+
+std::string makeFifo(const std::string& name) {
+    const std::string p = tmpDir() + "/" + name;
+    fs::remove(p);
+    EXPECT_EQ(::mkfifo(p.c_str(), 0600), 0) << p;
+    return p;
+}
+
+}  // namespace
+
+// A named pipe given as input would block a reader forever: every loader checks first.
+TEST(VolumeIO, NamedPipesAreRejectedWithoutOpeningThem) {
+    for (const char* ext : {".mhd", ".mha", ".nrrd", ".nhdr", ".nii", ".nii.gz", ".vti", ".vdb", "_8x8x8_uint8.raw"}) {
+        const std::string p = makeFifo(std::string("pipe") + ext);
+        expectFifoRejected(p, [&] { loadVolume(p, quiet()); }, std::string("loadVolume ") + ext);
+        expectFifoRejected(p, [&] { loadBrickedVolume(p, quiet()); }, std::string("loadBrickedVolume ") + ext);
+    }
+    {
+        const std::string p = makeFifo("pipe.bin");
+        VolumeLoadOptions raw = quiet();
+        raw.dims = std::array<int, 3>{2, 2, 2};
+        raw.type = "u8";
+        expectFifoRejected(p, [&] { loadVolume(p, raw); }, "raw with --dims");
+    }
+    // the format readers called directly
+    const std::string vdb = makeFifo("direct.vdb"), vti = makeFifo("direct.vti");
+    expectFifoRejected(vdb, [&] { loadVDB(vdb, quiet()); }, "loadVDB");
+    expectFifoRejected(vdb, [&] { loadVDBBricked(vdb, quiet()); }, "loadVDBBricked");
+    expectFifoRejected(vti, [&] { loadVTI(vti, quiet()); }, "loadVTI");
+    // detached data files: MetaImage, NRRD (single file, slice pattern, LIST, line skip)
+    const std::string data = makeFifo("pipedata.raw");
+    expectFifoRejected(data, [&] {
+        loadVolume(writeFile("det.mhd", "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\nElementDataFile = pipedata.raw\n"), quiet());
+    }, "MetaImage data file");
+    expectFifoRejected(data, [&] {
+        loadVolume(writeFile("det.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: pipedata.raw\n"), quiet());
+    }, "NRRD data file");
+    expectFifoRejected(data, [&] {
+        loadVolume(writeFile("detgz.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: gzip\ndata file: pipedata.raw\n"), quiet());
+    }, "NRRD gzip data file");
+    expectFifoRejected(data, [&] {
+        loadVolume(writeFile("detskip.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\nline skip: 1\ndata file: pipedata.raw\n"), quiet());
+    }, "NRRD data file with line skip");
+    expectFifoRejected(data, [&] {
+        loadVolume(writeFile("detlist.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: LIST\npipedata.raw\n"), quiet());
+    }, "NRRD data file LIST");
+    const std::string slice = makeFifo("pipeslice.2");
+    writeFile("pipeslice.1", std::string(4, 'x'));
+    expectFifoRejected(slice, [&] {
+        loadVolume(writeFile("detpat.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: pipeslice.%d 1 2 1\n"), quiet());
+    }, "NRRD slice pattern");
+    // a DICOM directory holding a pipe: VTK's reader would open every file in it
+    const std::string dir = tmpDir() + "/dicom_with_pipe";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    writeFile("dicom_with_pipe/a.dcm", std::string(128, '\0') + "DICM" + std::string(600, '\x33'));
+    const std::string dpipe = dir + "/b.dcm";
+    ASSERT_EQ(::mkfifo(dpipe.c_str(), 0600), 0);
+    expectFifoRejected(dpipe, [&] { loadVolume(dir, quiet()); }, "DICOM directory");
+    // --tf FILE.json and the DICOM modality reader
+    const std::string tf = makeFifo("pipe_tf.json");
+    expectFifoRejected(tf, [&] { loadTransferFunction(tf); }, "loadTransferFunction");
+    expectFifoRejected(tf, [&] { resolveTransferFunction(tf); }, "resolveTransferFunction");
+    expectFifoRejected(dpipe, [&] { readDicomModality(dpipe); }, "readDicomModality");
 }
