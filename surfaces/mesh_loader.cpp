@@ -421,7 +421,7 @@ MeshFileKind meshFileKind(const std::string& file) {
         if (!isPlyFile(file)) return MeshFileKind::Ply;  // let the loader report it
         try {
             const PlyHeader h = readPlyHeader(file);
-            return h.count("face") > 0 ? MeshFileKind::Ply : MeshFileKind::NotMesh;
+            return plyHasFaces(h) ? MeshFileKind::Ply : MeshFileKind::NotMesh;
         } catch (const Error&) {
             return MeshFileKind::Ply;  // broken files are reported by the loader
         }
@@ -452,8 +452,13 @@ Mesh loadMesh(const std::string& file) {
         if (!h.find("vertex") || !h.hasProperty("vertex", "x") || !h.hasProperty("vertex", "y") ||
             !h.hasProperty("vertex", "z"))
             throw Error(file, "PLY file has no vertex element with x, y, z");
-        if (h.count("face") == 0) throw Error(file, "PLY file has no faces (a point cloud, see `rtfact points`)");
-        checkMeshMemory(file, h.count("vertex"), h.count("face"), h.fileBytes - h.headerBytes);
+        if (!plyHasFaces(h)) {
+            for (const PlyElement& e : h.elements)
+                if (isPlyFaceElement(e.name) && e.count > 0 && !plyIndexList(e))
+                    throw Error(file, "PLY element '" + e.name + "' has no vertex_indices list");
+            throw Error(file, "PLY file has no faces or triangle strips (a point cloud, see `rtfact points`)");
+        }
+        checkMeshMemory(file, h.count("vertex"), plyTriangleEstimate(h), h.fileBytes - h.headerBytes);
         m = readPly(file, h);
     } else if (ext == ".stl") {
         checkStl(file);
