@@ -1,5 +1,6 @@
 #include "surfaces/ply_header.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -170,7 +171,11 @@ uint64_t plyTriangleEstimate(const PlyHeader& h) {
     for (const PlyElement& e : h.elements) {
         const PlyProperty* idx = plyIndexList(e);
         if (e.name == "face") faces += e.count;
-        if (e.name == "tristrips" && idx) stripIndexBytes = ascii ? 2 : idx->typeBytes;
+        // ASCII: most indices of n vertices have about as many digits as n - 1 (the
+        // vertices' own bytes count as 2 per value, so the rest is generous anyway).
+        if (e.name == "tristrips" && idx)
+            stripIndexBytes = ascii ? 1 + std::max<int>(1, int(std::to_string(std::max<uint64_t>(h.count("vertex"), 1) - 1).size()))
+                                    : idx->typeBytes;
         // The same minimum sizes as the header check: counts only for lists.
         uint64_t per = 0;
         for (const PlyProperty& p : e.props) per += ascii ? 2 : p.isList ? p.countBytes : p.typeBytes;

@@ -54,7 +54,9 @@ const PlyProperty* plyIndexList(const PlyElement& e);
 bool plyHasFaces(const PlyHeader& h);
 // The triangles to expect, for the memory check before reading: one per polygon (a
 // polygon fans to more, but counts are what the other formats check too) and, for
-// strips, one per index that the bytes left after the other elements can hold.
+// strips, one per index that the bytes left after the other elements can hold (binary:
+// an upper bound; ASCII: an estimate from the typical index width). The check after
+// reading uses the real count.
 uint64_t plyTriangleEstimate(const PlyHeader& h);
 // True when the file starts with the "ply" magic line.
 bool isPlyFile(const std::string& file);

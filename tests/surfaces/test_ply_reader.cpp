@@ -294,6 +294,20 @@ TEST(PlyStrips, BadStripsGiveOneLineErrors) {
     EXPECT_EQ(loadMesh(stripFile("good.ply", "binary_little_endian", {3, 0, 4, 1})).triangles(), 2u);
 }
 
+// The memory check before reading counts what strips can hold: at least the triangles
+// they give and, in binary files, at most one per index (ASCII: within a small factor).
+TEST(PlyStrips, TriangleEstimateBoundsStrips) {
+    constexpr int w = 30, h = 20;
+    const uint64_t triangles = 2 * (w - 1) * (h - 1), entries = gridStrips(w, h).size();
+    for (const char* format : kFormats) {
+        const std::string path = gridStripFile(std::string("estimate_") + format + ".ply", format, w, h, false);
+        SCOPED_TRACE(path);
+        const uint64_t estimate = plyTriangleEstimate(readPlyHeader(path));
+        EXPECT_GE(estimate, triangles);
+        EXPECT_LE(estimate, std::string(format) == "ascii" ? 2 * entries : entries);
+    }
+}
+
 // A header past the size limit (here a 10 MB comment) is reported as such, not as a
 // missing end_header; a header that really ends early still says end_header.
 TEST(PlyHeader, GiantCommentNamesTheLimit) {
