@@ -26,6 +26,7 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
 #include "core/util/vtk_quiet.h"
 #include "surfaces/ply_header.h"
@@ -241,6 +242,11 @@ bool parseFloats(std::string_view s, float* out, int n) {
 }
 
 std::vector<MeshMaterial> readMtl(const std::string& file) {
+    try {
+        requireRegularFile(file);
+    } catch (const Error& e) {
+        throw Error(file, std::string("material library ") + e.what());
+    }
     std::ifstream in(file);
     if (!in) throw Error(file, "cannot open material library");
     std::vector<MeshMaterial> mats;
@@ -417,11 +423,19 @@ Mesh readObj(const std::string& file) {
 
 MeshFileKind meshFileKind(const std::string& file) {
     const std::string ext = lowerExt(file);
+    // Headers are only looked at in regular files (a named pipe would block the read);
+    // anything else with a mesh extension is the loader's to report.
+    bool regular = true;
+    try {
+        requireRegularFile(file);
+    } catch (const Error&) {
+        regular = false;
+    }
     if (ext == ".ply") {
-        if (!isPlyFile(file)) return MeshFileKind::Ply;  // let the loader report it
+        if (!regular || !isPlyFile(file)) return MeshFileKind::Ply;  // let the loader report it
         try {
             const PlyHeader h = readPlyHeader(file);
-            return h.count("face") > 0 ? MeshFileKind::Ply : MeshFileKind::NotMesh;
+            return plyHasFaces(h) ? MeshFileKind::Ply : MeshFileKind::NotMesh;
         } catch (const Error&) {
             return MeshFileKind::Ply;  // broken files are reported by the loader
         }
@@ -430,6 +444,7 @@ MeshFileKind meshFileKind(const std::string& file) {
     if (ext == ".stl") return MeshFileKind::Stl;
     if (ext == ".vtp") return MeshFileKind::Vtp;
     if (ext == ".vtk") {
+        if (!regular) return MeshFileKind::VtkLegacy;
         try {
             return checkVtkLegacy(file, false) ? MeshFileKind::VtkLegacy : MeshFileKind::NotMesh;
         } catch (const Error&) {
@@ -440,9 +455,7 @@ MeshFileKind meshFileKind(const std::string& file) {
 }
 
 Mesh loadMesh(const std::string& file) {
-    std::error_code ec;
-    if (!fs::exists(file, ec)) throw Error(file, "no such file or directory");
-    if (fs::is_directory(file, ec)) throw Error(file, "is a directory");
+    requireRegularFile(file);
     if (fileSize(file) == 0) throw Error(file, "empty file");
     const std::string ext = lowerExt(file);
     Mesh m;
@@ -452,8 +465,13 @@ Mesh loadMesh(const std::string& file) {
         if (!h.find("vertex") || !h.hasProperty("vertex", "x") || !h.hasProperty("vertex", "y") ||
             !h.hasProperty("vertex", "z"))
             throw Error(file, "PLY file has no vertex element with x, y, z");
-        if (h.count("face") == 0) throw Error(file, "PLY file has no faces (a point cloud, see `rtfact points`)");
-        checkMeshMemory(file, h.count("vertex"), h.count("face"), h.fileBytes - h.headerBytes);
+        if (!plyHasFaces(h)) {
+            for (const PlyElement& e : h.elements)
+                if (isPlyFaceElement(e.name) && e.count > 0 && !plyIndexList(e))
+                    throw Error(file, "PLY element '" + e.name + "' has no vertex_indices list");
+            throw Error(file, "PLY file has no faces or triangle strips (a point cloud, see `rtfact points`)");
+        }
+        checkMeshMemory(file, h.count("vertex"), plyTriangleEstimate(h), h.fileBytes - h.headerBytes);
         m = readPly(file, h);
     } else if (ext == ".stl") {
         checkStl(file);

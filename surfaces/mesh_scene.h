@@ -2,6 +2,7 @@
 // with the generic packet intersectors around TriangleIntersector. Every core integrator
 // (eyelight, direct light) and the surface integrators of this library render it.
 #pragma once
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <type_traits>
@@ -17,6 +18,7 @@
 #include "core/accel/sah_kdtree_builder.h"
 #include "core/accel/wide_bvh_intersector.h"
 #include "core/concepts/scene.h"
+#include "core/render/secondary_rays.h"
 #include "core/render/tracer.h"
 #include "core/util/huge_pages.h"
 #include "surfaces/mesh.h"
@@ -68,6 +70,9 @@ struct MeshScene {
     bool buildWide = true;  // set before build()
     WideBVH<Triangle, kMeshWideArity> wide;
     Tracer<WideBVHIntersector<TriangleIntersector>> wideTracer;
+    // When set, counts the rays the wide BVH answered: tests check that the wide path
+    // really runs (null by default: one branch per query, no shared cache line).
+    std::atomic<uint64_t>* wideRayCount = nullptr;
     std::vector<Vec3f> materialColor;  // diffuse colour per material id
     std::vector<ImageTexture> diffuseMaps;  // per material id (image empty: none)
     AABB box;
@@ -144,13 +149,24 @@ struct MeshScene {
     // Incoherent rays: lane by lane through the wide BVH when it exists.
     template <int N>
     Hit<N> intersectIncoherent(const RayPacket<N>& rays, const Mask<N>& active) const {
-        if (hasWide()) return wideTracer.intersect(wide, rays, active);
+        if (hasWide()) {
+            countWide(active);
+            return wideTracer.intersect(wide, rays, active);
+        }
         return tracer.intersect(accel, rays, active);
     }
     template <int N>
     Mask<N> occludedIncoherent(const RayPacket<N>& rays, const Mask<N>& active) const {
-        if (hasWide()) return wideTracer.occluded(wide, rays, active);
+        if (hasWide()) {
+            countWide(active);
+            return wideTracer.occluded(wide, rays, active);
+        }
         return tracer.occluded(accel, rays, active);
+    }
+
+    template <int N>
+    void countWide(const Mask<N>& active) const {
+        if (wideRayCount) wideRayCount->fetch_add(uint64_t(popcount(active)), std::memory_order_relaxed);
     }
 
     // Position, interpolated shading normal, geometric normal (both facing the ray),
@@ -201,5 +217,7 @@ struct MeshScene {
 };
 static_assert(GeometryScene<MeshScene<BVH<Triangle>>>);
 static_assert(GeometryScene<MeshScene<KdTree<Triangle>>>);
+// WideSecondaryRays reach the wide BVH only through these queries.
+static_assert(IncoherentQueries<MeshScene<BVH<Triangle>>, 1> && IncoherentQueries<MeshScene<BVH<Triangle>>, 64>);
 
 }  // namespace rtfact

@@ -1,5 +1,6 @@
 #include "surfaces/ply_header.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -51,13 +52,25 @@ PlyHeader readPlyHeader(const std::string& file) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw Error(file, "cannot open file");
     if (!isPlyFile(file)) throw Error(file, "not a PLY file (missing 'ply' magic)");
+    // Lines are read byte by byte up to the limit: getline would take in a whole binary
+    // file (or a giant comment) as one line before any check could run.
+    std::streambuf* sb = in.rdbuf();
+    uint64_t consumed = 0;
     std::string line;
-    std::getline(in, line);
+    auto nextLine = [&]() {
+        line.clear();
+        for (int c; (c = sb->sbumpc()) != std::char_traits<char>::eof();) {
+            if (++consumed > kMaxPlyHeaderBytes)
+                throw Error(file, "PLY header longer than " + std::to_string(kMaxPlyHeaderBytes) +
+                                      " bytes (the limit) before end_header");
+            if (c == '\n') return true;
+            line.push_back(char(c));
+        }
+        return !line.empty();
+    };
+    nextLine();  // "ply"
     bool haveFormat = false, ended = false;
-    int lines = 0;
-    while (std::getline(in, line)) {
-        // A header is a few dozen short lines; anything else is a broken file.
-        if (++lines > 10000 || line.size() > 4096) throw Error(file, "PLY header too long or not terminated");
+    while (nextLine()) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         std::istringstream ls(line);
         std::string kw;
@@ -114,7 +127,7 @@ PlyHeader readPlyHeader(const std::string& file) {
     }
     if (!ended) throw Error(file, "PLY header not terminated by end_header");
     if (!haveFormat) throw Error(file, "PLY header has no format line");
-    h.headerBytes = uint64_t(in.tellg());
+    h.headerBytes = consumed;
     // The smallest data each element can occupy: binary sizes are exact for scalars and
     // a lower bound for lists (count only); ASCII needs at least one digit and one
     // separator per value.
@@ -135,6 +148,42 @@ PlyHeader readPlyHeader(const std::string& file) {
         throw Error(file, m.str());
     }
     return h;
+}
+
+bool isPlyFaceElement(const std::string& element) { return element == "face" || element == "tristrips"; }
+
+const PlyProperty* plyIndexList(const PlyElement& e) {
+    for (const PlyProperty& p : e.props)
+        if (p.isList && (p.name == "vertex_indices" || p.name == "vertex_index")) return &p;
+    return nullptr;
+}
+
+bool plyHasFaces(const PlyHeader& h) {
+    for (const PlyElement& e : h.elements)
+        if (isPlyFaceElement(e.name) && e.count > 0 && plyIndexList(e)) return true;
+    return false;
+}
+
+uint64_t plyTriangleEstimate(const PlyHeader& h) {
+    const bool ascii = h.format == PlyHeader::Format::Ascii;
+    uint64_t faces = 0, otherBytes = 0;
+    int stripIndexBytes = 0;
+    for (const PlyElement& e : h.elements) {
+        const PlyProperty* idx = plyIndexList(e);
+        if (e.name == "face") faces += e.count;
+        // ASCII: most indices of n vertices have about as many digits as n - 1 (the
+        // vertices' own bytes count as 2 per value, so the rest is generous anyway).
+        if (e.name == "tristrips" && idx)
+            stripIndexBytes = ascii ? 1 + std::max<int>(1, int(std::to_string(std::max<uint64_t>(h.count("vertex"), 1) - 1).size()))
+                                    : idx->typeBytes;
+        // The same minimum sizes as the header check: counts only for lists.
+        uint64_t per = 0;
+        for (const PlyProperty& p : e.props) per += ascii ? 2 : p.isList ? p.countBytes : p.typeBytes;
+        otherBytes += per * e.count;
+    }
+    const uint64_t data = h.fileBytes > h.headerBytes ? h.fileBytes - h.headerBytes : 0;
+    const uint64_t strips = stripIndexBytes && data > otherBytes ? (data - otherBytes) / uint64_t(stripIndexBytes) : 0;
+    return faces + strips;
 }
 
 }  // namespace rtfact

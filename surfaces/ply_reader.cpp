@@ -1,6 +1,8 @@
 // PLY data reader (ASCII, binary little/big endian). Ours rather than VTK's: vtkPLYReader
 // crashes on corrupted face lists (found by flipping bytes of a real file), and every
 // count and index here is checked against the bytes actually present.
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 
@@ -11,6 +13,13 @@
 namespace rtfact {
 
 namespace {
+
+// Which element entry is being read, for messages only (built when one is needed).
+struct Where {
+    const std::string& element;
+    uint64_t k;
+    std::string str() const { return element + " " + std::to_string(k); }
+};
 
 class PlyData {
    public:
@@ -47,6 +56,31 @@ class PlyData {
         return double(int64_t(u << shift) >> shift);
     }
 
+    // A list's length, checked against the bytes left, so that a corrupt count can drive
+    // neither a long loop nor an allocation.
+    uint64_t listLength(const PlyProperty& p, const Where& where) {
+        const double c = value(p.countKind, p.countBytes);
+        if (!(c >= 0) || c != std::floor(c)) throw Error(file_, where.str() + ": bad list length " + number(c));
+        // Binary values take their size; ASCII ones a character and a separator (but the last).
+        const double fits = ascii() ? double(remaining() + 1) / 2 : double(remaining()) / p.typeBytes;
+        if (c > fits)
+            throw Error(file_, "truncated or corrupt PLY data: " + where.str() + " lists " + number(c) + " values but only " +
+                                   std::to_string(remaining()) + " bytes are left");
+        return uint64_t(c);
+    }
+    void skipList(const PlyProperty& p, uint64_t n) {
+        for (uint64_t j = 0; j < n; ++j) value(p.typeKind, p.typeBytes);
+    }
+    bool ascii() const { return h_.format == PlyHeader::Format::Ascii; }
+    const std::string& file() const { return file_; }
+    size_t remaining() const { return buf_.size() - pos_; }
+    // Short text for any double (a corrupt value may be 1e300).
+    static std::string number(double v) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%.10g", v);
+        return b;
+    }
+
    private:
     double asciiValue() {
         while (pos_ < buf_.size() && std::isspace(static_cast<unsigned char>(buf_[pos_]))) ++pos_;
@@ -66,6 +100,54 @@ class PlyData {
     size_t pos_ = 0;
 };
 
+// One vertex index of a face or strip: an integer below the vertex count.
+uint32_t vertexIndex(const std::string& file, double x, uint64_t nv, const Where& where) {
+    if (!(x >= 0 && x < double(nv)) || x != std::floor(x))
+        throw Error(file, where.str() + " refers to vertex " + PlyData::number(x) + " of " + std::to_string(nv));
+    return uint32_t(x);
+}
+
+// A polygon of n vertices, fanned from its first; degenerate triangles are dropped.
+void readPolygon(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, const Where& where,
+                 std::vector<uint32_t>& out) {
+    uint32_t first = 0, prev = 0;
+    for (uint64_t j = 0; j < n; ++j) {
+        const uint32_t id = vertexIndex(data.file(), data.value(p.typeKind, p.typeBytes), nv, where);
+        if (j == 0) first = id;
+        else if (j >= 2 && first != prev && prev != id && first != id) out.insert(out.end(), {first, prev, id});
+        prev = id;
+    }
+}
+
+// Triangle strips: -1 (or, binary unsigned, the all-ones value: primitive restart) ends
+// a strip. Every second triangle of a strip is reversed (b, a, c) so all keep the
+// orientation of the first; degenerate ones (used to stitch strips) are dropped but still
+// count for the alternation.
+void readStrip(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, const Where& where,
+               std::vector<uint32_t>& out) {
+    const double restartU = p.typeKind == 'u' && !data.ascii() ? std::ldexp(1.0, 8 * p.typeBytes) - 1 : -1;
+    uint64_t run = 0;  // indices in the current strip
+    uint32_t a = 0, b = 0;
+    for (uint64_t j = 0; j < n; ++j) {
+        const double x = data.value(p.typeKind, p.typeBytes);
+        if (x == -1 || x == restartU) {
+            run = 0;
+            continue;
+        }
+        if (!(x >= 0 && x < double(nv)) || x != std::floor(x))
+            throw Error(data.file(), where.str() + " entry " + std::to_string(j) + " refers to vertex " + PlyData::number(x) +
+                                         " of " + std::to_string(nv) + " (only -1 ends a strip)");
+        const uint32_t c = uint32_t(x);
+        if (run >= 2 && a != b && b != c && a != c) {
+            if (run & 1) out.insert(out.end(), {b, a, c});
+            else out.insert(out.end(), {a, b, c});
+        }
+        a = b;
+        b = c;
+        ++run;
+    }
+}
+
 }  // namespace
 
 Mesh readPly(const std::string& file, const PlyHeader& h) {
@@ -73,6 +155,7 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
     Mesh m;
     m.source = file;
     const uint64_t nv = h.count("vertex");
+    if (nv > uint64_t(UINT32_MAX)) throw Error(file, "more than 2^32 vertices");
     for (const PlyElement& e : h.elements) {
         if (e.name == "vertex") {
             int px = -1, py = -1, pz = -1, nx = -1, ny = -1, nz = -1, cr = -1, cg = -1, cb = -1, tu = -1, tv = -1;
@@ -103,9 +186,7 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
                 for (size_t i = 0; i < e.props.size(); ++i) {
                     const PlyProperty& p = e.props[i];
                     if (p.isList) {
-                        const double c = data.value(p.countKind, p.countBytes);
-                        if (c < 0 || c > 1e6) throw Error(file, "bad list length in PLY vertex data");
-                        for (int j = 0; j < int(c); ++j) data.value(p.typeKind, p.typeBytes);
+                        data.skipList(p, data.listLength(p, Where{e.name, k}));
                         continue;
                     }
                     v[i] = data.value(p.typeKind, p.typeBytes);
@@ -118,30 +199,20 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
                     m.uvs[2 * k + 1] = float(v[size_t(tv)]);
                 }
             }
-        } else if (e.name == "face") {
+        } else if (isPlyFaceElement(e.name)) {
+            const PlyProperty* idx = plyIndexList(e);
+            const bool strips = e.name == "tristrips";
             for (uint64_t k = 0; k < e.count; ++k) {
                 for (const PlyProperty& p : e.props) {
                     if (!p.isList) {
                         data.value(p.typeKind, p.typeBytes);
                         continue;
                     }
-                    const double c = data.value(p.countKind, p.countBytes);
-                    if (c < 0 || c > 1e6 || c != double(int64_t(c))) throw Error(file, "bad face vertex count in PLY data");
-                    const bool indices = p.name == "vertex_indices" || p.name == "vertex_index";
-                    uint32_t first = 0, prev = 0;
-                    for (int j = 0; j < int(c); ++j) {
-                        const double x = data.value(p.typeKind, p.typeBytes);
-                        if (!indices) continue;
-                        if (!(x >= 0 && x < double(nv)))
-                            throw Error(file, "face " + std::to_string(k) + " refers to vertex " + std::to_string(int64_t(x)) +
-                                                  " of " + std::to_string(nv));
-                        const uint32_t id = uint32_t(x);
-                        // Polygons are fanned; degenerate triangles are dropped.
-                        if (j == 0) first = id;
-                        else if (j >= 2 && first != prev && prev != id && first != id)
-                            m.indices.insert(m.indices.end(), {first, prev, id});
-                        prev = id;
-                    }
+                    const Where where{e.name, k};
+                    const uint64_t c = data.listLength(p, where);
+                    if (&p != idx) data.skipList(p, c);
+                    else if (strips) readStrip(data, p, c, nv, where, m.indices);
+                    else readPolygon(data, p, c, nv, where, m.indices);
                 }
             }
         } else {
@@ -152,9 +223,7 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
                         data.value(p.typeKind, p.typeBytes);
                         continue;
                     }
-                    const double c = data.value(p.countKind, p.countBytes);
-                    if (c < 0 || c > 1e6) throw Error(file, "bad list length in PLY element '" + e.name + "'");
-                    for (int j = 0; j < int(c); ++j) data.value(p.typeKind, p.typeBytes);
+                    data.skipList(p, data.listLength(p, Where{e.name, k}));
                 }
         }
     }

@@ -34,16 +34,18 @@ struct MeshOpts {
     int maxDepth = 6;
 };
 
-// "point:x,y,z" or "dir:x,y,z"; lights are scaled so that the scene centre receives
-// an irradiance of 0.85 (white surfaces facing the light stay below clipping).
+// Lights are scaled so that the scene centre receives an irradiance of 0.85 (white
+// surfaces facing the light stay below clipping).
+PointLight scaledPointLight(Vec3f p, const AABB& box) {
+    const Vec3f d = p - box.center();
+    return PointLight{p, Vec3f(0.85f * 3.14159265f * std::max(dot(d, d), 1e-12f))};
+}
+
+// "point:x,y,z" or "dir:x,y,z".
 AnyLight parseLight(const std::string& s, const AABB& box) {
     const size_t c = s.find(':');
     const std::string kind = c == std::string::npos ? "" : s.substr(0, c);
-    if (kind == "point") {
-        const Vec3f p = parseVec3(s.substr(c + 1), "--light");
-        const Vec3f d = p - box.center();
-        return PointLight{p, Vec3f(0.85f * 3.14159265f * std::max(dot(d, d), 1e-12f))};
-    }
+    if (kind == "point") return scaledPointLight(parseVec3(s.substr(c + 1), "--light"), box);
     if (kind == "dir") {
         const Vec3f d = parseVec3(s.substr(c + 1), "--light");
         if (length(d) == 0.0f) throw CLI::ValidationError("--light", "direction must not be zero");
@@ -70,7 +72,9 @@ void applyMaterial(Mesh& m, const std::string& spec) {
         mat.dissolve = 0.0f;
         mat.kd = Vec3f(1.0f);
         try {
-            mat.ior = arg.empty() ? 1.5f : std::stof(arg);
+            size_t used = 0;
+            mat.ior = arg.empty() ? 1.5f : std::stof(arg, &used);
+            if (!arg.empty() && used != arg.size()) throw std::invalid_argument(arg);
         } catch (const std::exception&) {
             throw CLI::ValidationError("--material", "glass:IOR expects a number, got '" + arg + "'");
         }
@@ -129,11 +133,13 @@ int renderMesh(const MeshOpts& o, std::shared_ptr<const Mesh> mesh, Stats& stats
         LightList lights;
         for (const std::string& l : o.lights) lights.push_back(parseLight(l, box));
         if (lights.empty()) {
-            // Default: a key light above and to the left of the camera.
+            // Default: a key light above and to the left of the camera. Built directly: a
+            // round trip through "point:x,y,z" text lost small coordinates (6 decimals) and
+            // blamed --light for any non-finite camera.
             const Vec3f e = box.extent();
             const float r = std::max(length(e), 1e-6f);
             const Vec3f p = frame.eye + normalize(frame.up) * (0.8f * r) - normalize(cross(frame.at - frame.eye, frame.up)) * (0.6f * r);
-            lights.push_back(parseLight("point:" + std::to_string(p.x) + "," + std::to_string(p.y) + "," + std::to_string(p.z), box));
+            lights.push_back(scaledPointLight(p, box));
         }
         if (o.integrator == "whitted") {
             WhittedIntegrator w;

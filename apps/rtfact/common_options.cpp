@@ -33,6 +33,9 @@ CLI::Validator numberValidator(std::function<std::string(double)> check, std::st
             const std::optional<double> v = parseNumber(text);
             if (!v) return "expected a number, got '" + text + "'";
             if (!std::isfinite(*v)) return "expected a finite number, got '" + text + "'";
+            // The options are floats: 1e300 would become Inf and 1e-50 zero after the check.
+            if (!std::isfinite(float(*v))) return "is too large for a float, got '" + text + "'";
+            if (*v != 0 && float(*v) == 0.0f) return "is too small for a float, got '" + text + "'";
             return check(*v);
         },
         std::move(description));
@@ -120,6 +123,7 @@ void CommonOptions::finalize() {
     dispatchPacketSize(packet, [&]<int N>() { ok = true; });
     if (!ok) throw CLI::ValidationError("--packet", "must be one of " + supportedPacketSizes());
     if (eyeV && atV && length(*eyeV - *atV) == 0.0f) throw CLI::ValidationError("--eye", "eye and --at coincide");
+    if (upV && length(*upV) == 0.0f) throw CLI::ValidationError("--up", "must not be zero");
     setProgressEnabled(!quiet);
 }
 
@@ -133,6 +137,15 @@ CameraFrame CommonOptions::frame(const AABB& bounds, Vec3f viewDir, Vec3f upDefa
         f.eye = *atV + (f.eye - bounds.center());
     }
     if (upV) f.up = *upV;
+    // An eye on its target or an up vector along the view leaves the camera without axes
+    // (a NaN image): the user's options are errors, the default up is replaced.
+    const Vec3f view = f.at - f.eye;
+    if (!(length(view) > 0.0f)) throw CLI::ValidationError("--eye", "coincides with the camera target (--at or the scene centre)");
+    auto alongView = [&](Vec3f u) { return !(length(cross(normalize(view), normalize(u))) > 1e-3f); };
+    if (alongView(f.up)) {
+        if (upV) throw CLI::ValidationError("--up", "is parallel to the viewing direction");
+        f.up = alongView(Vec3f(0, 1, 0)) ? Vec3f(0, 0, 1) : Vec3f(0, 1, 0);
+    }
     return f;
 }
 

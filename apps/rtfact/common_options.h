@@ -37,7 +37,8 @@ struct CommonOptions {
 // Validators for floating-point options: CLI::Range and CLI::PositiveNumber let NaN
 // through (every comparison with NaN is false) and print huge bounds in full.
 // finiteRange: a finite number in [lo, hi]; positiveFinite: a finite number > 0;
-// finiteNumber: any finite number.
+// finiteNumber: any finite number. "Finite" as a float (the options are floats): values
+// beyond the float range, or so small they would round to zero, are rejected too.
 CLI::Validator finiteRange(double lo, double hi);
 CLI::Validator positiveFinite();
 CLI::Validator finiteNumber();

@@ -15,10 +15,18 @@ struct WideSecondaryRays {};    // single rays through the scene's wide BVH
 template <class T>
 concept SecondaryRayPolicy = std::same_as<T, PacketSecondaryRays> || std::same_as<T, WideSecondaryRays>;
 
+// A scene with its own queries for incoherent rays. Named (not an inline probe) so that
+// a scene meant to have them can static_assert it: a signature that drifts would
+// otherwise send its rays through packets without a word.
+template <class Scene, int N>
+concept IncoherentQueries = requires(const Scene& scene, const RayPacket<N>& rays, const Mask<N>& active) {
+    scene.template intersectIncoherent<N>(rays, active);
+    { scene.template occludedIncoherent<N>(rays, active) } -> std::same_as<Mask<N>>;
+};
+
 template <SecondaryRayPolicy Policy, int N, class Scene>
 auto intersectSecondary(const Scene& scene, const RayPacket<N>& rays, const Mask<N>& active) {
-    if constexpr (std::same_as<Policy, WideSecondaryRays> &&
-                  requires { scene.template intersectIncoherent<N>(rays, active); })
+    if constexpr (std::same_as<Policy, WideSecondaryRays> && IncoherentQueries<Scene, N>)
         return scene.template intersectIncoherent<N>(rays, active);
     else
         return scene.template intersect<N>(rays, active);
@@ -26,8 +34,7 @@ auto intersectSecondary(const Scene& scene, const RayPacket<N>& rays, const Mask
 
 template <SecondaryRayPolicy Policy, int N, class Scene>
 Mask<N> occludedSecondary(const Scene& scene, const RayPacket<N>& rays, const Mask<N>& active) {
-    if constexpr (std::same_as<Policy, WideSecondaryRays> &&
-                  requires { scene.template occludedIncoherent<N>(rays, active); })
+    if constexpr (std::same_as<Policy, WideSecondaryRays> && IncoherentQueries<Scene, N>)
         return scene.template occludedIncoherent<N>(rays, active);
     else
         return scene.template occluded<N>(rays, active);

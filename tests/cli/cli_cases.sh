@@ -123,5 +123,87 @@ RTFACT_MEMORY_LIMIT=1M expect 1 '^rtfact: error: hostile.png: needs .* for a 102
 RTFACT_MEMORY_LIMIT=lots expect 1 "^rtfact: error: RTFACT_MEMORY_LIMIT: not a size: 'lots'" -- spheres --size 8x8 -o hostile.png
 if [ -e hostile.png ]; then echo "FAIL: an image was written although memory checks failed"; fails=$((fails + 1)); fi
 
+# NaN and Inf in numeric options: exit 2, naming the option, in a short message (CLI::Range
+# let NaN through and printed its bounds in full). The inputs are valid, so a missing
+# check shows as a render with exit 0.
+{ printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n'
+  printf '0 0 0\n1 0 0\n0 1 0\n'; } > three.ply
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' > tri.ply
+head -c 1000 /dev/zero > opt.raw
+option_error() {  # option_error OPTION ARGS... : exit 2, a short message naming OPTION and no other option
+  local option="$1"
+  shift
+  local err
+  err=$(timeout 120 "$rtfact" "$@" --size 8x8 --quiet -o opt.png 2>&1 >/dev/null)
+  local rc=$?
+  local first
+  first=$(head -n 1 <<<"$err")
+  local others
+  others=$(grep -Eo -- '--[a-z-]+' <<<"$first" | grep -vx -- "$option")
+  if [ $rc -ne 2 ] || [[ "$first" != "rtfact: error: "*"$option"* ]] || [ -n "$others" ] || [ ${#first} -gt 160 ]; then
+    echo "FAIL: rtfact $* -> exit $rc (want 2 naming $option in a short line): $err"
+    fails=$((fails + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+option_error --fov points three.ply --fov nan
+option_error --radius-factor points three.ply --radius-factor nan
+option_error --lod-quality points three.ply --lod-quality nan
+option_error --radius points three.ply --radius nan
+option_error --radius points three.ply --radius -1
+option_error --radius points three.ply --radius inf
+option_error --radius points three.ply --radius 1e300
+option_error --radius points three.ply --radius 1e-50
+option_error --level volume opt.raw --dims 10,10,10 --type u8 --level -1e39
+option_error --level volume opt.raw --dims 10,10,10 --type u8 --level nan
+option_error --level volume opt.raw --dims 10,10,10 --type u8 --level inf
+option_error --iso volume opt.raw --dims 10,10,10 --type u8 --mode iso --iso nan
+option_error --iso volume opt.raw --dims 10,10,10 --type u8 --iso inf
+option_error --window volume opt.raw --dims 10,10,10 --type u8 --window nan
+option_error --step volume opt.raw --dims 10,10,10 --type u8 --step inf
+option_error --fov mesh tri.ply --fov nan
+option_error --fov mesh tri.ply --fov inf
+option_error --eye mesh tri.ply --eye nan,0,0
+option_error --up mesh tri.ply --up 0,inf,0
+option_error --up mesh tri.ply --up 0,0,0
+option_error --light mesh tri.ply --light point:1,nan,1
+option_error --material mesh tri.ply --material lambert:nan,1,1
+option_error --material mesh tri.ply --material glass:nan --integrator whitted
+option_error --material mesh tri.ply --material glass:1.5x --integrator whitted
+
+# Named pipes as inputs: a reader opening one blocks until a writer comes, so every input
+# is checked to be a regular file first: exit 1 at once with one line naming the pipe
+# (timeout 20 makes a hang a failure instead of a blocked test).
+mkdir -p pipes
+pipe_case() {  # pipe_case FILE ARGS... : rtfact ARGS exits 1 with one line "rtfact: error: FILE: ..."
+  local file="$1"
+  shift
+  local err
+  err=$(timeout 20 "$rtfact" "$@" 2>&1 >/dev/null)
+  local rc=$?
+  local lines
+  lines=$(printf '%s\n' "$err" | grep -c .)
+  if [ $rc -ne 1 ] || [ "$lines" -ne 1 ] || [[ "$err" != "rtfact: error: $file: "* ]]; then
+    echo "FAIL: rtfact $* -> exit $rc$([ $rc -eq 124 ] && echo ' (hung: killed after 20 s)'), $lines line(s): $err"
+    fails=$((fails + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+for ext in xyz ply pcd pts; do mkfifo "pipes/cloud.$ext"; pipe_case "pipes/cloud.$ext" points "pipes/cloud.$ext" --quiet -o hostile.png; done
+for ext in vdb vti nrrd nii mhd; do mkfifo "pipes/vol.$ext"; pipe_case "pipes/vol.$ext" volume "pipes/vol.$ext" --quiet -o hostile.png; done
+mkfifo pipes/vol.raw
+pipe_case pipes/vol.raw volume pipes/vol.raw --dims 10,10,10 --type u8 --quiet -o hostile.png
+for ext in ply obj stl vtk; do mkfifo "pipes/mesh.$ext"; pipe_case "pipes/mesh.$ext" mesh "pipes/mesh.$ext" --quiet -o hostile.png; done
+mkfifo pipes/tf.json
+pipe_case pipes/tf.json volume opt.raw --dims 10,10,10 --type u8 --tf pipes/tf.json --quiet -o hostile.png
+mkfifo pipes/info.ply
+pipe_case pipes/info.ply info pipes/info.ply
+mkfifo pipes/lib.mtl
+printf 'mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > pipes/withmtl.obj
+pipe_case pipes/lib.mtl mesh pipes/withmtl.obj --quiet -o hostile.png
+if [ -e hostile.png ]; then echo "FAIL: an image was written for a named-pipe input"; fails=$((fails + 1)); fi
+
 echo "$passes passed, $fails failed"
 [ $fails -eq 0 ]

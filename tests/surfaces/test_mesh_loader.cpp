@@ -9,6 +9,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <future>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "core/util/error.h"
 #include "surfaces/mesh_loader.h"
@@ -236,6 +241,38 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
     // VTK legacy with fewer coordinates than declared: VTK only warns, we fail.
     expectError(write("short.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\n"
                                    "POLYGONS 1 4\n3 0 1 2\n"));
+}
+
+// A named pipe blocks whoever opens it until a writer comes: every mesh input (and an
+// MTL library) is refused before it is opened, and meshFileKind does not look inside.
+// A reader stuck on the pipe fails the test instead of hanging it: after 10 s a writer
+// opens and closes the pipe, so the reader sees an empty file and returns.
+template <class F>
+void withoutBlocking(const std::string& fifo, F&& f) {
+    auto run = std::async(std::launch::async, std::forward<F>(f));
+    if (run.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+        ADD_FAILURE() << "blocked on the named pipe " << fifo;
+        const int fd = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+        if (fd >= 0) close(fd);
+    }
+    run.get();
+}
+
+std::string makeFifo(const std::string& path) {
+    fs::remove(path);
+    EXPECT_EQ(mkfifo(path.c_str(), 0600), 0) << path;
+    return path;
+}
+
+TEST(MeshLoader, NamedPipesAreRefusedWithoutOpening) {
+    for (const char* ext : {".ply", ".obj", ".stl", ".vtk", ".vtp"}) {
+        const std::string fifo = makeFifo(dir() + "/pipe" + ext);
+        withoutBlocking(fifo, [&] { EXPECT_NE(meshFileKind(fifo), MeshFileKind::NotMesh); });
+        withoutBlocking(fifo, [&] { expectError(fifo, "named pipe"); });
+    }
+    const std::string mtl = makeFifo(dir() + "/pipe_lib.mtl");
+    const std::string obj = write("pipe_mtl.obj", "mtllib pipe_lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    withoutBlocking(mtl, [&] { expectError(obj, "named pipe", mtl); });
 }
 
 // The CLI: one line "rtfact: error: <file>: <what>" and exit code 1.

@@ -4,6 +4,7 @@
 // spheres and triangles, at packet sizes 1, native and 64.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <random>
 
 #include "core/accel/sah_bvh_builder.h"
@@ -279,13 +280,34 @@ void expectSameImage(const std::vector<float>& a, const std::vector<float>& b) {
 TEST(WideBVH, IntegratorsSameImageEitherStructure) {
     Mesh a = test::heightField(20, 4);
     a.append(test::uvSphere({0.2f, 0.5f, -0.1f}, 0.35f, 12));
-    const MeshScene<BVH<Triangle>> scene(std::make_shared<const Mesh>(a));
+    MeshScene<BVH<Triangle>> scene(std::make_shared<const Mesh>(a));
+    // Both conditions of the wide path: a wide BVH was built and the scene offers the
+    // incoherent queries; the counter then proves the wide renders used it and the packet
+    // renders did not (otherwise both images could come from packets and agree trivially).
+    ASSERT_TRUE(scene.hasWide());
+    static_assert(IncoherentQueries<MeshScene<BVH<Triangle>>, simd::kNativeWidth>);
+    std::atomic<uint64_t> wideRays{0};
+    scene.wideRayCount = &wideRays;
+    auto rendered = [&](const auto& integ, uint64_t& wide) {
+        wideRays = 0;
+        std::vector<float> img = renderWith(scene, integ, 64, 48);
+        wide = wideRays.load();
+        return img;
+    };
     AOIntegratorT<PacketSecondaryRays> aoP;
     AOIntegratorT<WideSecondaryRays> aoW;
     aoP.samples = aoW.samples = 4;
-    expectSameImage(renderWith(scene, aoP, 64, 48), renderWith(scene, aoW, 64, 48));
+    uint64_t wideP = 0, wideW = 0;
+    const std::vector<float> aoImgP = rendered(aoP, wideP), aoImgW = rendered(aoW, wideW);
+    // About 450 of the 3072 pixels see the mesh; each of their hits sends 4 AO rays.
+    EXPECT_EQ(wideP, 0u);
+    EXPECT_GT(wideW, 4u * 300u);
+    expectSameImage(aoImgP, aoImgW);
     PathIntegratorT<PacketSecondaryRays> ptP;
     PathIntegratorT<WideSecondaryRays> ptW;
     ptP.background = ptW.background = Vec3f(1.0f);
-    expectSameImage(renderWith(scene, ptP, 64, 48), renderWith(scene, ptW, 64, 48));
+    const std::vector<float> ptImgP = rendered(ptP, wideP), ptImgW = rendered(ptW, wideW);
+    EXPECT_EQ(wideP, 0u);
+    EXPECT_GT(wideW, 300u);  // at least the first bounce of every pixel on the mesh
+    expectSameImage(ptImgP, ptImgW);
 }
