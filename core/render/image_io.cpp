@@ -11,6 +11,7 @@
 #include <random>
 
 #include "core/util/error.h"
+#include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
 
 namespace rtfact {
@@ -135,7 +136,7 @@ void writeImage(const std::string& path, int width, int height, const std::vecto
 Image readImage(const std::string& path) {
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw Error(path, "is a directory, not an image");
-    if (!fs::exists(path, ec)) throw Error(path, "no such file or directory");
+    requireRegularFile(path);  // a named pipe would block the image reader
     const uint64_t fileBytes = fs::file_size(path, ec);
     if (ec || fileBytes == 0) throw Error(path, "empty image file");
     SilenceStderr quiet;

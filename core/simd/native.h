@@ -279,7 +279,7 @@ template <int W>
 RTFACT_INLINE nvec<float, W> gather(const float* base, nvec<int32_t, W> idx) {
     if constexpr (W == 1) return base[idx];
 #if RTFACT_NATIVE_WIDTH >= 16
-    else if constexpr (W == 16) return _mm512_i32gather_ps((__m512i)idx, base, 4);
+    else if constexpr (W == 16) return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), __mmask16(0xFFFF), (__m512i)idx, base, 4);
 #endif
 #if RTFACT_NATIVE_WIDTH >= 8
     else if constexpr (W == 8) return _mm256_i32gather_ps(base, (__m256i)idx, 4);
@@ -295,7 +295,8 @@ template <int W>
 RTFACT_INLINE nvec<int32_t, W> gather(const int32_t* base, nvec<int32_t, W> idx) {
     if constexpr (W == 1) return base[idx];
 #if RTFACT_NATIVE_WIDTH >= 16
-    else if constexpr (W == 16) return (nvec<int32_t, W>)_mm512_i32gather_epi32((__m512i)idx, base, 4);
+    else if constexpr (W == 16)
+        return (nvec<int32_t, W>)_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(0xFFFF), (__m512i)idx, base, 4);
 #endif
 #if RTFACT_NATIVE_WIDTH >= 8
     else if constexpr (W == 8) return (nvec<int32_t, W>)_mm256_i32gather_epi32(base, (__m256i)idx, 4);

@@ -91,7 +91,7 @@ hostile badindex.ply mesh badindex.ply
 for ext in mhd nrrd nhdr nii nii.gz vti vdb; do : > "vol.$ext"; hostile "vol.$ext" volume "vol.$ext"; done
 head -c 1000 /dev/zero > vol.raw
 hostile vol.raw volume vol.raw --dims 10,10,11 --type u8
-expect 1 '^rtfact: error: (vol.raw|--dims): .*too large' -- volume vol.raw --dims 100000,100000,100000 --type u16 -o hostile.png
+expect 2 '^rtfact: error: --dims: .*too large' -- volume vol.raw --dims 100000,100000,100000 --type u16 -o hostile.png
 printf 'ObjectType = Image\nNDims = 3\nDimSize = 0 5 5\nElementType = MET_UCHAR\nElementDataFile = vol.raw\n' > zero.mhd
 hostile zero.mhd volume zero.mhd
 printf '{"colors": [[0, 1, 1]]' > bad.json
@@ -110,7 +110,7 @@ hostile tex.png mesh quad.obj
 { printf 'ply\nformat ascii 1.0\nelement vertex 10000\nproperty float x\nproperty float y\nproperty float z\nend_header\n'
   awk 'BEGIN { for (i = 0; i < 10000; ++i) print i % 100, int(i / 100), (i * 7) % 13 }'; } > cloud.ply
 RTFACT_MEMORY_LIMIT=256K expect 1 '^rtfact: error: cloud.ply: needs .* for loading 10000 points but only 256 KiB are available \(subsample' -- points cloud.ply --size 8x8 -o hostile.png
-RTFACT_MEMORY_LIMIT=1M expect 1 '^rtfact: error: cloud.ply: needs 1\.1 MiB for preparing and building 10000 points .*\(normal estimation is the largest part' -- points cloud.ply --size 8x8 -o hostile.png
+RTFACT_MEMORY_LIMIT=1M expect 1 '^rtfact: error: cloud.ply: needs 1\.3 MiB for preparing and building 10000 points .*\(normal estimation is the largest part' -- points cloud.ply --size 8x8 -o hostile.png
 { printf 'ply\nformat ascii 1.0\nelement vertex 10000\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n'
   awk 'BEGIN { for (i = 0; i < 10000; ++i) print i % 100, int(i / 100), 0, 0, 0, 1 }'; } > cloudn.ply
 RTFACT_MEMORY_LIMIT=768K expect 1 '^rtfact: error: cloudn.ply: needs 703 KiB for preparing .* \(subsample' -- points cloudn.ply --radius 0.5 --size 8x8 -o hostile.png
@@ -204,6 +204,21 @@ mkfifo pipes/lib.mtl
 printf 'mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > pipes/withmtl.obj
 pipe_case pipes/lib.mtl mesh pipes/withmtl.obj --quiet -o hostile.png
 if [ -e hostile.png ]; then echo "FAIL: an image was written for a named-pipe input"; fails=$((fails + 1)); fi
+
+# Non-finite points are dropped with one warning line (none with --quiet); a cloud with
+# no finite point is an error.
+printf '0 0 0\n1 0 0\n0 1 0\nnan 0 0\n1 inf 0\n' > some_nan.xyz
+expect 0 '^rtfact: warning: some_nan.xyz: 2 points with non-finite coordinates dropped$' -- points some_nan.xyz --size 16x16 -o nan_ok.png
+if [ -n "$("$rtfact" points some_nan.xyz --size 16x16 --quiet -o nan_ok.png 2>&1 >/dev/null)" ]; then
+  echo "FAIL: --quiet still printed the non-finite warning"; fails=$((fails + 1))
+fi
+printf 'nan 0 0\n1 inf 0\n' > all_nan.xyz
+hostile all_nan.xyz points all_nan.xyz
+# A texture given as a named pipe is refused, not read.
+mkfifo pipes/tex.png
+printf 'newmtl m\nmap_Kd tex.png\n' > pipes/tex.mtl
+printf 'mtllib tex.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n' > pipes/textured.obj
+pipe_case pipes/tex.png mesh pipes/textured.obj --quiet -o hostile.png
 
 echo "$passes passed, $fails failed"
 [ $fails -eq 0 ]
