@@ -15,7 +15,9 @@
 namespace rtfact::bench {
 
 using Clock = std::chrono::steady_clock;
-inline double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+inline double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 // "x,y,z" for option `opt`.
 inline Vec3f parseVec(const std::string& s, const char* opt) {

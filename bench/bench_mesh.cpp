@@ -25,11 +25,11 @@
 #include "bench/bench_commands.h"
 #include "bench/bench_common.h"
 #include "bench/bench_embree.h"
+#include "core/render/ao_integrator.h"
 #include "core/render/pinhole_camera.h"
+#include "core/render/random.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
-#include "core/render/random.h"
-#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
 
@@ -39,10 +39,10 @@ namespace {
 // What both tracers produce per pixel, so their results can be compared.
 struct Frame {
     int w, h;
-    std::vector<float> t;       // nearest hit distance (inf: miss)
-    std::vector<float> shade;   // eyelight value
-    std::vector<uint8_t> lit;   // shadow result: 1 = light visible
-    std::vector<int32_t> id;    // triangle hit (-1: miss)
+    std::vector<float> t;      // nearest hit distance (inf: miss)
+    std::vector<float> shade;  // eyelight value
+    std::vector<uint8_t> lit;  // shadow result: 1 = light visible
+    std::vector<int32_t> id;   // triangle hit (-1: miss)
     Frame(int w_, int h_)
         : w(w_), h(h_), t(size_t(w_) * h_), shade(size_t(w_) * h_), lit(size_t(w_) * h_), id(size_t(w_) * h_, -1) {}
 };
@@ -52,7 +52,6 @@ struct Setup {
     Vec3f light;
     std::vector<Vec3f> triNormal;  // unit geometric normal per input triangle
 };
-
 
 // ---- RTfact ---------------------------------------------------------------------------
 
@@ -158,7 +157,8 @@ double timeRange(int threads, size_t n, size_t grain, F&& f) {
     tbb::task_arena arena(threads);
     const auto t0 = Clock::now();
     arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain),
+                          [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); });
     });
     return msSince(t0);
 }
@@ -187,8 +187,10 @@ void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr,
         Mask<N> active(true);
         for (int i = 0; i < N; ++i) {
             const size_t k = p + size_t(i);
-            if (k < e) r.setLane(i, sr.org[k], sr.dir[k], 0.0f, ao ? sr.tMaxAO : kInfinity);
-            else r.setLane(i, sr.org[b], sr.dir[b], 0.0f, 0.0f), active.set(i, false);
+            if (k < e)
+                r.setLane(i, sr.org[k], sr.dir[k], 0.0f, ao ? sr.tMaxAO : kInfinity);
+            else
+                r.setLane(i, sr.org[b], sr.dir[b], 0.0f, 0.0f), active.set(i, false);
         }
         r.finalize();
         if (ao) {
@@ -202,7 +204,6 @@ void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr,
 }
 
 // ---- Embree -----------------------------------------------------------------------------
-
 
 struct EmbreeSide {
     RTCDevice device = nullptr;
@@ -360,8 +361,8 @@ uint64_t countHits(const Frame& f) {
 template <int N>
 int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat,
         int secSamples) {
-    std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w, h,
-                N, allThreads);
+    std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w,
+                h, N, allThreads);
     auto meshPtr = std::make_shared<const Mesh>(mesh);
     const std::vector<int> threadCounts = allThreads > 1 ? std::vector<int>{1, allThreads} : std::vector<int>{1};
     MeshScene<BVH<Triangle>> scene;
@@ -390,7 +391,8 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
         scene.build();
         std::printf("wide_bvh_build_ms_all_threads=%.2f (packet BVH and wide BVH together)\n", msSince(t0));
     }
-    std::printf("memory_bytes: rtfact=%.0f embree=%.0f ratio_memory=%.3f\n", rtBytes, emBytes, rtBytes / std::max(emBytes, 1.0));
+    std::printf("memory_bytes: rtfact=%.0f embree=%.0f ratio_memory=%.3f\n", rtBytes, emBytes,
+                rtBytes / std::max(emBytes, 1.0));
 
     RTfactSide<N> rt{scene, setup};
     Frame fr(w, h), fe(w, h), base(w, h);
@@ -405,7 +407,8 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
             rp.ms = std::min(rp.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fr, x, y); }));
             ep.ms = std::min(ep.ms, timeTiles(T, w, h, [&](int x, int y) { em->primaryTile(fe, x, y); }));
             rs.ms = std::min(rs.ms, timeTiles(T, w, h, [&](int x, int y) { rt.shadowTile(fr, base, x, y); }));
-            esSurf.ms = std::min(esSurf.ms, timeTiles(T, w, h, [&](int x, int y) { em->shadowTile(fe, base, x, y, false); }));
+            esSurf.ms =
+                std::min(esSurf.ms, timeTiles(T, w, h, [&](int x, int y) { em->shadowTile(fe, base, x, y, false); }));
             es.ms = std::min(es.ms, timeTiles(T, w, h, [&](int x, int y) { em->shadowTile(fe, base, x, y, true); }));
         }
         rp.rays = ep.rays = uint64_t(w) * h;
@@ -429,8 +432,8 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
             rw.ms = std::min(rw.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fw, x, y, true); }));
         }
         rw.rays = rp.rays = uint64_t(w) * h;
-        std::printf("threads=%d primary_mrays: rtfact_packet=%.2f rtfact_wide_single=%.2f ratio_wide_vs_packet=%.3f\n", T,
-                    rp.mrays(), rw.mrays(), rw.mrays() / rp.mrays());
+        std::printf("threads=%d primary_mrays: rtfact_packet=%.2f rtfact_wide_single=%.2f ratio_wide_vs_packet=%.3f\n",
+                    T, rp.mrays(), rw.mrays(), rw.mrays() / rp.mrays());
     }
     // Secondary rays (incoherent): the same list for every tracer.
     if (secSamples > 0) {
@@ -443,24 +446,27 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
                 Result p, wd, e;
                 for (int r = 0; r < repeat; ++r) {
                     p.ms = std::min(p.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
-                        rtSecondary<N>(scene, sr, b, en, false, ao, outP);
-                    }));
+                                        rtSecondary<N>(scene, sr, b, en, false, ao, outP);
+                                    }));
                     wd.ms = std::min(wd.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
-                        rtSecondary<N>(scene, sr, b, en, true, ao, outW);
-                    }));
+                                         rtSecondary<N>(scene, sr, b, en, true, ao, outW);
+                                     }));
                     e.ms = std::min(e.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
-                        embreeSecondary(em->scene, sr, b, en, ao, outE);
-                    }));
+                                        embreeSecondary(em->scene, sr, b, en, ao, outE);
+                                    }));
                 }
                 p.rays = wd.rays = e.rays = sr.size();
-                std::printf("threads=%d %s_mrays: rtfact_wide_single=%.2f rtfact_packet%d=%.2f embree_single=%.2f "
-                            "ratio_wide_vs_embree=%.3f ratio_wide_vs_packet=%.3f\n",
-                            T, name, wd.mrays(), N, p.mrays(), e.mrays(), wd.mrays() / e.mrays(), wd.mrays() / p.mrays());
+                std::printf(
+                    "threads=%d %s_mrays: rtfact_wide_single=%.2f rtfact_packet%d=%.2f embree_single=%.2f "
+                    "ratio_wide_vs_embree=%.3f ratio_wide_vs_packet=%.3f\n",
+                    T, name, wd.mrays(), N, p.mrays(), e.mrays(), wd.mrays() / e.mrays(), wd.mrays() / p.mrays());
             }
             size_t diffPW = 0, diffWE = 0;
             for (size_t i = 0; i < sr.size(); ++i) {
                 const auto same = [&](float a, float b) {
-                    return ao ? a == b : (std::isinf(a) == std::isinf(b) && (std::isinf(a) || std::fabs(a - b) <= 1e-3f * std::max(1.0f, a)));
+                    return ao ? a == b
+                              : (std::isinf(a) == std::isinf(b) &&
+                                 (std::isinf(a) || std::fabs(a - b) <= 1e-3f * std::max(1.0f, a)));
                 };
                 diffPW += !same(outP[i], outW[i]);
                 diffWE += !same(outW[i], outE[i]);
@@ -476,13 +482,15 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
         rtOnlyShadow += !fr.lit[i] && fe.lit[i];
         emOnlyShadow += fr.lit[i] && !fe.lit[i];
     }
-    std::printf("agreement: primary_hit_diff_pixels=%zu shadowed_only_by_rtfact=%zu shadowed_only_by_embree=%zu\n", hitDiff,
-                rtOnlyShadow, emOnlyShadow);
+    std::printf("agreement: primary_hit_diff_pixels=%zu shadowed_only_by_rtfact=%zu shadowed_only_by_embree=%zu\n",
+                hitDiff, rtOnlyShadow, emOnlyShadow);
     const int last = int(threadCounts.size()) - 1;
     std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\nratio_build=%.3f\n", worstPrimary, worstShadow,
                 rtBuild[last] / emBuild[last]);
-    std::printf("(ratios: RTfact/Embree throughput, the worse of 1 and %d threads; build: RTfact/Embree time at %d threads, lower is better)\n",
-                allThreads, threadCounts[last]);
+    std::printf(
+        "(ratios: RTfact/Embree throughput, the worse of 1 and %d threads; build: RTfact/Embree time at %d threads, "
+        "lower is better)\n",
+        allThreads, threadCounts[last]);
     return 0;
 }
 
@@ -500,21 +508,26 @@ int benchMesh(int argc, char** argv) {
     app.add_option("--fov", fov, "Vertical field of view (degrees)")->capture_default_str();
     app.add_option("--threads", threads, "All-threads figure uses this many (0: all cores)")->capture_default_str();
     app.add_option("--size", size, "Image size WxH")->capture_default_str();
-    app.add_option("--packet", packet, "RTfact packet size: 16, 64 or 256")->capture_default_str()->check(CLI::IsMember({16, 64, 256}));
+    app.add_option("--packet", packet, "RTfact packet size: 16, 64 or 256")
+        ->capture_default_str()
+        ->check(CLI::IsMember({16, 64, 256}));
     app.add_option("--grid", grid, "Many occluders: a GxG grid of copies of the mesh on a ground plane")
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
     app.add_option("--secondary", secondary, "Secondary (AO and bounce) rays per primary hit; 0: skip")
         ->capture_default_str()
         ->check(CLI::Range(0, 64));
-    app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")->capture_default_str()->check(CLI::Range(1, 100));
+    app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
     int w = 1024, h = 1024;
-    if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 16384 || h > 16384 || w % 16 || h % 16)
+    if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 16384 || h > 16384 || w % 16 ||
+        h % 16)
         throw Error("", "--size: expected WxH, multiples of 16 in 16..16384");
     Mesh mesh = loadMesh(file);
     if (grid > 1) {

@@ -81,7 +81,6 @@ struct RTfactSide {
     }
 };
 
-
 struct EmbreeSide {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
@@ -105,8 +104,10 @@ struct EmbreeSide {
         scene = rtcNewScene(device);
         rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 16, discs.size()));
-        auto* n = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 12, discs.size()));
+        auto* v = static_cast<float*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 16, discs.size()));
+        auto* n = static_cast<float*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 12, discs.size()));
         tbb::parallel_for(size_t(0), discs.size(), [&](size_t i) {
             const Disc& d = discs[i];
             const Vec3f nn = d.n();
@@ -157,7 +158,8 @@ struct EmbreeSide {
 double psnr8(const Frame& a, const Frame& b) {
     double se = 0;
     for (size_t i = 0; i < a.shade.size(); ++i) {
-        const double x = std::lround(std::clamp(a.shade[i], 0.0f, 1.0f) * 255.0f), y = std::lround(std::clamp(b.shade[i], 0.0f, 1.0f) * 255.0f);
+        const double x = std::lround(std::clamp(a.shade[i], 0.0f, 1.0f) * 255.0f),
+                     y = std::lround(std::clamp(b.shade[i], 0.0f, 1.0f) * 255.0f);
         se += (x - y) * (x - y);
     }
     const double mse = se / double(a.shade.size());
@@ -169,8 +171,9 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
         std::vector<float> qualities, std::vector<float> repScales, int leafSize, double loadMs) {
     const float quality = qualities.front();
     const size_t n = discs.size();
-    std::printf("file=%s\npoints=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nrep_scale=%.3g\nload_ms=%.1f\n", file.c_str(), n,
-                w, h, N, all, quality, repScales.front(), loadMs);
+    std::printf(
+        "file=%s\npoints=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nrep_scale=%.3g\nload_ms=%.1f\n",
+        file.c_str(), n, w, h, N, all, quality, repScales.front(), loadMs);
     const std::vector<int> threadCounts = all > 1 ? std::vector<int>{1, all} : std::vector<int>{1};
     PointScene scene;
     LoDKdTreeBuilder builder;
@@ -194,15 +197,18 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
     double emBuild = 1e30;
     {
         tbb::task_arena arena(all);
-        for (int r = 0; r < std::max(1, std::min(repeat, 2)); ++r) arena.execute([&] { emBuild = std::min(emBuild, em.build()); });
+        for (int r = 0; r < std::max(1, std::min(repeat, 2)); ++r)
+            arena.execute([&] { emBuild = std::min(emBuild, em.build()); });
     }
     const double rtBytes = double(scene.tree.memoryBytes());
     // Embree keeps its own copy of the points (16 B centre+radius, 12 B normal) plus the BVH.
     const double emBytes = double(gEmbreeBytes.load()) + double(n) * 28.0;
     std::printf("build_ms: rtfact=%.1f embree=%.1f ratio_build_time=%.3f rtfact_points_per_s=%.3g\n", rtBuild, emBuild,
                 rtBuild / emBuild, double(n) / (rtBuild * 1e-3));
-    std::printf("memory: rtfact_bytes_per_point=%.2f embree_bytes_per_point=%.2f (embree: BVH from its monitor + 28 B/point buffers)\n",
-                rtBytes / double(n), emBytes / double(n));
+    std::printf(
+        "memory: rtfact_bytes_per_point=%.2f embree_bytes_per_point=%.2f (embree: BVH from its monitor + 28 B/point "
+        "buffers)\n",
+        rtBytes / double(n), emBytes / double(n));
 
     Frame ff(w, h), fl(w, h), fe(w, h);
     RTfactSide<N> rt{scene, cam};
@@ -219,8 +225,8 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
             emb = std::min(emb, timeTiles(T, w, h, [&](int x, int y) { em.tile(fe, x, y); }));
         }
         std::printf("threads=%d frame_ms: full=%.1f lod=%.1f embree=%.1f\n", T, full, lod, emb);
-        std::printf("threads=%d mrays: full=%.2f lod=%.2f embree=%.2f ratio_full=%.3f ratio_lod=%.3f\n", T, mr(full), mr(lod),
-                    mr(emb), emb / full, emb / lod);
+        std::printf("threads=%d mrays: full=%.2f lod=%.2f embree=%.2f ratio_full=%.3f ratio_lod=%.3f\n", T, mr(full),
+                    mr(lod), mr(emb), emb / full, emb / lod);
         worstFull = std::min(worstFull, emb / full);
         worstLod = std::min(worstLod, emb / lod);
     }
@@ -238,8 +244,10 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
                 lod = std::min(lod, timeTiles(all, w, h, [&](int x, int y) { rt.tile(fl, x, y); }));
                 emb = std::min(emb, timeTiles(all, w, h, [&](int x, int y) { em.tile(fe, x, y); }));
             }
-            std::printf("quality=%.3g rep_scale=%.3g threads=%d lod_frame_ms=%.1f embree_frame_ms=%.1f ratio_lod=%.3f lod_mrays=%.2f psnr_lod_vs_full=%.2f\n",
-                        q, s, all, lod, emb, emb / lod, mr(lod), psnr8(fl, ff));
+            std::printf(
+                "quality=%.3g rep_scale=%.3g threads=%d lod_frame_ms=%.1f embree_frame_ms=%.1f ratio_lod=%.3f "
+                "lod_mrays=%.2f psnr_lod_vs_full=%.2f\n",
+                q, s, all, lod, emb, emb / lod, mr(lod), psnr8(fl, ff));
         }
     std::printf("ratio_full=%.3f\nratio_lod=%.3f\n", worstFull, worstLod);
     std::printf("(ratios: Embree frame time / RTfact frame time, the worse of 1 and %d threads)\n", all);
@@ -261,12 +269,17 @@ int benchPoints(int argc, char** argv) {
     app.add_option("--fov", fov, "Vertical field of view (degrees)")->capture_default_str();
     app.add_option("--threads", threads, "All-threads figure uses this many (0: all cores)")->capture_default_str();
     app.add_option("--size", size, "Image size WxH")->capture_default_str();
-    app.add_option("--packet", packet, "RTfact packet size: 1, 16, 64 or 256")->capture_default_str()->check(CLI::IsMember({1, 16, 64, 256}));
-    app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")->capture_default_str()->check(CLI::Range(1, 100));
+    app.add_option("--packet", packet, "RTfact packet size: 1, 16, 64 or 256")
+        ->capture_default_str()
+        ->check(CLI::IsMember({1, 16, 64, 256}));
+    app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
     app.add_option("--lod-quality", quality, "LoD quality for the LoD run (more values: extra LoD runs at all threads)")
         ->capture_default_str()
         ->check(CLI::Range(0.0f, 64.0f));
-    app.add_option("--rep-scale", repScale, "Hit radius of representatives / covering radius (more values: extra LoD runs)")
+    app.add_option("--rep-scale", repScale,
+                   "Hit radius of representatives / covering radius (more values: extra LoD runs)")
         ->capture_default_str()
         ->check(CLI::Range(0.1f, 1.0f));
     app.add_option("--leaf-size", leafSize, "Maximum points per leaf")->capture_default_str()->check(CLI::Range(1, 64));
@@ -279,7 +292,8 @@ int benchPoints(int argc, char** argv) {
         return app.exit(e);
     }
     int w = 1024, h = 1024;
-    if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 16384 || h > 16384 || w % 16 || h % 16)
+    if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 16384 || h > 16384 || w % 16 ||
+        h % 16)
         throw Error("", "--size: expected WxH, multiples of 16 in 16..16384");
     setProgressEnabled(false);
     const auto t0 = Clock::now();
@@ -301,10 +315,14 @@ int benchPoints(int argc, char** argv) {
     cloud = PointCloud{};
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
     switch (packet) {
-        case 1: return run<1>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
-        case 16: return run<16>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
-        case 256: return run<256>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
-        default: return run<64>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+        case 1:
+            return run<1>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+        case 16:
+            return run<16>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+        case 256:
+            return run<256>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+        default:
+            return run<64>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
     }
 }
 

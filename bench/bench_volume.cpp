@@ -51,7 +51,8 @@ struct VdbMarcher {
                   openvdb::tools::VolumeRayIntersector<openvdb::FloatGrid>& inter) const {
         using RayT = openvdb::math::Ray<double>;
         auto acc = grid->getConstAccessor();
-        openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(acc, grid->transform());
+        openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
+            acc, grid->transform());
         std::vector<RayT::TimeSpan> spans;
         uint64_t samples = 0;
         const int w = cam.width();
@@ -125,7 +126,8 @@ int benchVolume(int argc, char** argv) {
     app.add_option("--at", at, "Camera target x,y,z");
     app.add_option("--up", up, "Camera up x,y,z");
     app.add_option("--fov", fov, "Vertical FOV")->capture_default_str();
-    app.add_option("--threads", threads, "All-threads run count (0: all cores); a 1-thread run is always made")->capture_default_str();
+    app.add_option("--threads", threads, "All-threads run count (0: all cores); a 1-thread run is always made")
+        ->capture_default_str();
     app.add_option("--frames", frames, "Frames per measurement (best is reported)")->capture_default_str();
     app.add_option("--packet", packet, "RTfact packet size")->capture_default_str();
     app.add_option("--images", outPrefix, "Write PREFIX_rtfact.png and PREFIX_openvdb.png");
@@ -145,14 +147,18 @@ int benchVolume(int argc, char** argv) {
     auto t0 = Clock::now();
     VolumeGrid g;
     BrickedVolume vol;
-    if (isVdb) vol = loadVDBBricked(file, lo);  // sparse: never densified
-    else g = loadVolume(file, lo);
+    if (isVdb)
+        vol = loadVDBBricked(file, lo);  // sparse: never densified
+    else
+        g = loadVolume(file, lo);
     const double loadMs = msSince(t0);
     t0 = Clock::now();
     if (!isVdb) vol = brickVolume(g);
     if (std::fabs(vol.spacing.x - vol.spacing.y) > 1e-6f || std::fabs(vol.spacing.x - vol.spacing.z) > 1e-6f) {
-        std::printf("note: anisotropic spacing; both renderers use isotropic spacing %g here (OpenVDB's intersector needs uniform voxels)\n",
-                    double(minComponent(vol.spacing)));
+        std::printf(
+            "note: anisotropic spacing; both renderers use isotropic spacing %g here (OpenVDB's intersector needs "
+            "uniform voxels)\n",
+            double(minComponent(vol.spacing)));
         vol.spacing = g.spacing = Vec3f(minComponent(vol.spacing));
     }
     const auto range = vol.valueRange();
@@ -169,11 +175,11 @@ int benchVolume(int argc, char** argv) {
     if (!up.empty()) frame.up = parseVec(up, "--up");
     const PinholeCamera cam(frame, w, h);
     const int allThreads = resolveThreads(threads);
-    std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, bricks+TF %.0f ms\n", file.c_str(),
-                vol.dims[0], vol.dims[1], vol.dims[2], storageName(vol.storage), vol.sourceType.c_str(), vol.storedBricks(), vol.brickCount(),
-                double(vol.memoryBytes()) / 1048576.0, loadMs, buildMs);
-    std::printf("view %dx%d, tf %s window [%g, %g], step %g voxels, packet %d, frames %d (best reported)\n", w, h, tf.name.c_str(),
-                double(win.first), double(win.second), double(step), packet, frames);
+    std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, bricks+TF %.0f ms\n",
+                file.c_str(), vol.dims[0], vol.dims[1], vol.dims[2], storageName(vol.storage), vol.sourceType.c_str(),
+                vol.storedBricks(), vol.brickCount(), double(vol.memoryBytes()) / 1048576.0, loadMs, buildMs);
+    std::printf("view %dx%d, tf %s window [%g, %g], step %g voxels, packet %d, frames %d (best reported)\n", w, h,
+                tf.name.c_str(), double(win.first), double(win.second), double(step), packet, frames);
 
     struct Result {
         double ms = 0;
@@ -241,7 +247,8 @@ int benchVolume(int argc, char** argv) {
         // Our grid starts at the active bbox minimum; align the VDB index space with ours.
         openvdb::Coord bmin(0, 0, 0);
         if (isVdb) bmin = peer.grid->evalActiveVoxelBoundingBox().min();
-        xf->postTranslate(openvdb::Vec3d(vol.origin.x, vol.origin.y, vol.origin.z) - openvdb::Vec3d(bmin.x(), bmin.y(), bmin.z()) * double(vol.spacing.x));
+        xf->postTranslate(openvdb::Vec3d(vol.origin.x, vol.origin.y, vol.origin.z) -
+                          openvdb::Vec3d(bmin.x(), bmin.y(), bmin.z()) * double(vol.spacing.x));
         peer.grid->setTransform(xf);
         peer.tf = &table;
         const float k = float(table.size - 1) / (table.hi - table.lo);
@@ -249,15 +256,16 @@ int benchVolume(int argc, char** argv) {
         peer.tfAdd = (vol.offset - table.lo) * k + 0.5f;
         peer.step = step;
         peer.term = rs.earlyTermination;
-        std::printf("openvdb grid: %llu active voxels, built in %.0f ms\n", (unsigned long long)peer.grid->activeVoxelCount(), msSince(t0));
+        std::printf("openvdb grid: %llu active voxels, built in %.0f ms\n",
+                    (unsigned long long)peer.grid->activeVoxelCount(), msSince(t0));
     }
 
     std::printf("%-8s %7s %10s %9s %11s %12s\n", "who", "threads", "ms/frame", "Mrays/s", "Msamples/s", "samples");
     const double rays = double(w) * double(h);
     for (int th : {1, allThreads}) {
         const Result ours = runOurs(th);
-        std::printf("%-8s %7d %10.1f %9.2f %11.1f %12llu\n", "rtfact", th, ours.ms, rays / (ours.ms * 1e3), double(ours.samples) / (ours.ms * 1e3),
-                    (unsigned long long)ours.samples);
+        std::printf("%-8s %7d %10.1f %9.2f %11.1f %12llu\n", "rtfact", th, ours.ms, rays / (ours.ms * 1e3),
+                    double(ours.samples) / (ours.ms * 1e3), (unsigned long long)ours.samples);
         if (!skipPeer) {
             const Result theirs = runPeer(th);
             std::printf("%-8s %7d %10.1f %9.2f %11.1f %12llu\n", "openvdb", th, theirs.ms, rays / (theirs.ms * 1e3),
@@ -269,7 +277,8 @@ int benchVolume(int argc, char** argv) {
     if (!skipPeer) {
         double diff = 0;
         for (size_t i = 0; i < ourImage.size(); ++i) diff += std::fabs(ourImage[i] - peerImage[i]);
-        std::printf("mean |rtfact - openvdb| per channel: %.4f (same view and TF; sample positions differ)\n", diff / double(ourImage.size()));
+        std::printf("mean |rtfact - openvdb| per channel: %.4f (same view and TF; sample positions differ)\n",
+                    diff / double(ourImage.size()));
     }
     if (!outPrefix.empty()) {
         writeImage(outPrefix + "_rtfact.png", w, h, ourImage);

@@ -17,7 +17,10 @@ std::optional<PointFileInfo> probePcd(const std::string& file) { throw Error(fil
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size < 1) return 0;
     const int kind = data[0] % 3;
-    const std::string path = rtfact::fuzz::writeTemp(data + 1, size - 1, kind == 0 ? ".ply" : kind == 1 ? ".xyz" : ".pts");
+    const std::string path = rtfact::fuzz::writeTemp(data + 1, size - 1,
+                                                     kind == 0   ? ".ply"
+                                                     : kind == 1 ? ".xyz"
+                                                                 : ".pts");
     try {
         const auto cloud = kind == 0 ? rtfact::points::loadPly(path) : rtfact::points::loadXyz(path);
         (void)cloud;

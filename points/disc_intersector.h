@@ -15,13 +15,14 @@ struct DiscIntersector {
     };
 
     template <HitData D, int N>
-    RTFACT_INLINE void intersect(const Disc& d, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit, int firstChunk) const {
+    RTFACT_INLINE void intersect(const Disc& d, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit,
+                                 int firstChunk) const {
         intersectDisc(d.center, d.n(), d.radius * d.radius, int32_t(id), rays, hit, firstChunk);
     }
 
     template <int N>
-    RTFACT_INLINE static void intersectDisc(Vec3f c, Vec3f n, float r2, int32_t id, const RayPacket<N>& rays, Hit<N>& hit,
-                                            int firstChunk) {
+    RTFACT_INLINE static void intersectDisc(Vec3f c, Vec3f n, float r2, int32_t id, const RayPacket<N>& rays,
+                                            Hit<N>& hit, int firstChunk) {
         constexpr int W = Packet<N>::W;
         using P = Packet<W>;
         using PI = Packet<W, int32_t>;

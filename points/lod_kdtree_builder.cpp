@@ -55,7 +55,8 @@ Disc makeRep(const Agg& a, float radius) {
     const float len = length(n);
     r.normal = encodeNormal(len > 0 ? n / len : Vec3f(0, 0, 1));
     r.radius = radius;
-    r.rgba = packRGBA(Vec3f(float(a.col[0] * iw), float(a.col[1] * iw), float(a.col[2] * iw)), uint8_t(std::min(a.height, 255)));
+    r.rgba = packRGBA(Vec3f(float(a.col[0] * iw), float(a.col[1] * iw), float(a.col[2] * iw)),
+                      uint8_t(std::min(a.height, 255)));
     return r;
 }
 
@@ -98,7 +99,8 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
     }
     const int axis = cell.maxAxis();
     const size_t half = n / 2;
-    std::nth_element(d, d + half, d + n, [axis](const Disc& x, const Disc& y) { return x.center[axis] < y.center[axis]; });
+    std::nth_element(d, d + half, d + n,
+                     [axis](const Disc& x, const Disc& y) { return x.center[axis] < y.center[axis]; });
     const float split = d[half].center[axis];
     AABB lcell = cell, rcell = cell;
     lcell.hi[axis] = split;
@@ -109,7 +111,8 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
     Agg la, ra;
     auto bl = [&] { la = buildNode(ctx, d, half, lcell, left, lnext); };
     auto br = [&] { ra = buildNode(ctx, d + half, n - half, rcell, left + 1, rnext); };
-    if (n >= 8192) tbb::parallel_invoke(bl, br);
+    if (n >= 8192)
+        tbb::parallel_invoke(bl, br);
     else {
         bl();
         br();
@@ -125,8 +128,9 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
     a.height = std::max(la.height, ra.height) + 1;
     Disc rep = makeRep(a, 0.0f);
     const Disc &lr = la.rep, &rr = ra.rep;
-    const float r = std::min(std::max(length(lr.center - rep.center) + lr.radius, length(rr.center - rep.center) + rr.radius),
-                             boxCoverRadius(rep.center, a.box));
+    const float r =
+        std::min(std::max(length(lr.center - rep.center) + lr.radius, length(rr.center - rep.center) + rr.radius),
+                 boxCoverRadius(rep.center, a.box));
     rep.radius = r * 1.002f + 1e-7f;  // margin covers the padding of Disc::bounds()
     in.rep = rep;
     quantiseChildBox(in, 0, la.box);

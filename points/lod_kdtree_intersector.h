@@ -26,12 +26,11 @@ struct LoDNodeIntersector {
     template <int N>
     using Hit = typename ElemIsect::template Hit<N>;
 
-    void bind(const LoDKdTree& t) {
-        inner = t.inner.data();
-    }
+    void bind(const LoDKdTree& t) { inner = t.inner.data(); }
 
     template <HitData D, int N>
-    RTFACT_INLINE void intersect(const Disc& d, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit, int firstChunk) const {
+    RTFACT_INLINE void intersect(const Disc& d, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit,
+                                 int firstChunk) const {
         elem.template intersect<D>(d, id, rays, hit, firstChunk);
     }
 

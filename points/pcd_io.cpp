@@ -75,9 +75,10 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
         }
         if (kw == "FIELDS" || kw == "COLUMNS") {
             for (std::string s; ls >> s;) {
-                const bool ident = s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) {
-                    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
-                });
+                const bool ident =
+                    s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) {
+                        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+                    });
                 if (!ident) throw Error(file, "bad PCD field name '" + s.substr(0, 32) + "'");
                 h.fields.push_back(s);
             }
@@ -101,16 +102,21 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
                 if (s < 1 || s > 4096) throw Error(file, "bad PCD COUNT '" + t.substr(0, 32) + "'");
                 h.counts.push_back(s);
             }
-        } else if (kw == "WIDTH") readCount(h.width);
-        else if (kw == "HEIGHT") readCount(h.height);
-        else if (kw == "POINTS") { readCount(h.points); h.havePoints = true; }
-        else if (kw == "VIEWPOINT") {
+        } else if (kw == "WIDTH")
+            readCount(h.width);
+        else if (kw == "HEIGHT")
+            readCount(h.height);
+        else if (kw == "POINTS") {
+            readCount(h.points);
+            h.havePoints = true;
+        } else if (kw == "VIEWPOINT") {
             for (double& v : h.viewpoint) {
                 std::string t;
                 ls >> t;
                 char* end = nullptr;
                 v = std::strtod(t.c_str(), &end);
-                if (t.empty() || *end != '\0' || !std::isfinite(v)) throw Error(file, "bad PCD VIEWPOINT (seven numbers expected)");
+                if (t.empty() || *end != '\0' || !std::isfinite(v))
+                    throw Error(file, "bad PCD VIEWPOINT (seven numbers expected)");
             }
         } else if (kw == "DATA") {
             ls >> h.data;
@@ -127,7 +133,8 @@ PcdHeader parsePcdHeader(const MappedFile& f) {
         throw Error(file, "PCD header: FIELDS, SIZE, TYPE and COUNT have different lengths");
     for (size_t k = 0; k < h.fields.size(); ++k)
         if (h.types[k] == 'F' && h.sizes[k] != 4 && h.sizes[k] != 8)
-            throw Error(file, "PCD field '" + h.fields[k] + "' is a float of " + std::to_string(h.sizes[k]) + " bytes (4 or 8 expected)");
+            throw Error(file, "PCD field '" + h.fields[k] + "' is a float of " + std::to_string(h.sizes[k]) +
+                                  " bytes (4 or 8 expected)");
     if (!h.havePoints) h.points = h.width * h.height;
     if (h.width > (uint64_t(1) << 40) || h.height > (uint64_t(1) << 40) || h.width * h.height != h.points)
         throw Error(file, "PCD header: WIDTH x HEIGHT (" + std::to_string(h.width) + " x " + std::to_string(h.height) +
@@ -160,7 +167,8 @@ void validateBody(const MappedFile& f, const PcdHeader& h) {
         for (uint64_t i = 0; i < h.points; ++i) {
             while (p < end && (*p == '\n' || *p == '\r')) ++p;  // PCL skips empty lines
             if (p == end)
-                throw Error(file, "PCD body ends after " + std::to_string(i) + " of " + std::to_string(h.points) + " points");
+                throw Error(file,
+                            "PCD body ends after " + std::to_string(i) + " of " + std::to_string(h.points) + " points");
             size_t tokens = 0;
             bool inToken = false;
             for (; p < end && *p != '\n'; ++p) {
@@ -169,34 +177,37 @@ void validateBody(const MappedFile& f, const PcdHeader& h) {
                 inToken = !blank;
             }
             if (tokens != values)
-                throw Error(file, "PCD point " + std::to_string(i + 1) + " has " + std::to_string(tokens) + " values, expected " +
-                                      std::to_string(values));
+                throw Error(file, "PCD point " + std::to_string(i + 1) + " has " + std::to_string(tokens) +
+                                      " values, expected " + std::to_string(values));
         }
     } else if (h.data == "binary") {
         if (h.points > remaining / row)
-            throw Error(file, "PCD header declares " + std::to_string(h.points) + " points (" + std::to_string(h.points * row) +
-                                  " bytes) but only " + std::to_string(remaining) + " bytes follow the header");
+            throw Error(file, "PCD header declares " + std::to_string(h.points) + " points (" +
+                                  std::to_string(h.points * row) + " bytes) but only " + std::to_string(remaining) +
+                                  " bytes follow the header");
     } else {
         if (remaining < 8) throw Error(file, "PCD compressed body truncated (no size words)");
         uint32_t csize, usize;
         std::memcpy(&csize, f.data + h.bodyOffset, 4);
         std::memcpy(&usize, f.data + h.bodyOffset + 4, 4);
         if (csize > remaining - 8)
-            throw Error(file, "PCD compressed block of " + std::to_string(csize) + " bytes runs past the end of the file");
+            throw Error(file,
+                        "PCD compressed block of " + std::to_string(csize) + " bytes runs past the end of the file");
         if (uint64_t(usize) != h.points * row)
             throw Error(file, "PCD uncompressed size " + std::to_string(usize) + " differs from POINTS x row size " +
                                   std::to_string(h.points * row));
         // LZF expands at most 8x + a little; anything more is a lying header.
-        if (uint64_t(usize) > uint64_t(csize) * 9 + 64) throw Error(file, "PCD uncompressed size is implausible for the compressed block");
+        if (uint64_t(usize) > uint64_t(csize) * 9 + 64)
+            throw Error(file, "PCD uncompressed size is implausible for the compressed block");
     }
 }
-
 
 // Stores an ASCII value with the field's declared type (PCL writes packed rgb as a float
 // whose bits are the colour, or as an unsigned integer).
 void writeScalar(char* dst, char type, int size, double v) {
     if (type == 'F') {
-        if (size == 8) std::memcpy(dst, &v, 8);
+        if (size == 8)
+            std::memcpy(dst, &v, 8);
         else {
             const float f = float(v);
             std::memcpy(dst, &f, 4);
@@ -215,9 +226,12 @@ ScalarType scalarTypeOf(char type, int size) {
     if (type == 'F') return size == 8 ? ScalarType::F64 : ScalarType::F32;  // SIZE checked: 4 or 8
     const bool u = type == 'U';
     switch (size) {
-        case 1: return u ? ScalarType::U8 : ScalarType::I8;
-        case 2: return u ? ScalarType::U16 : ScalarType::I16;
-        default: return u ? ScalarType::U32 : ScalarType::I32;  // 8-byte integers: their low 4 bytes
+        case 1:
+            return u ? ScalarType::U8 : ScalarType::I8;
+        case 2:
+            return u ? ScalarType::U16 : ScalarType::I16;
+        default:
+            return u ? ScalarType::U32 : ScalarType::I32;  // 8-byte integers: their low 4 bytes
     }
 }
 
@@ -247,7 +261,9 @@ void lzfDecompress(const std::string& file, const unsigned char* in, size_t inSi
             for (size_t k = 0; k < len; ++k, ++op) out[op] = out[op - dist];  // may overlap
         }
     }
-    if (op != outSize) throw Error(file, "PCD compressed block decodes to " + std::to_string(op) + " bytes, expected " + std::to_string(outSize));
+    if (op != outSize)
+        throw Error(file, "PCD compressed block decodes to " + std::to_string(op) + " bytes, expected " +
+                              std::to_string(outSize));
 }
 
 // The body as n records of rowSize(h) bytes, whatever its encoding (checked by validateBody).
@@ -352,7 +368,8 @@ PointCloud loadPcd(const std::string& file) {
     for (size_t i = 0; i < n; ++i) {
         const char* rec = rows.data() + i * row;
         // Separate R/G/B fields are skipped above: colour comes from the packed rgb only.
-        for (const Slot& s : slots) storeAttr(sink, i, s.attr, readScalar(rec + s.offset, s.type, false), s.type, hasN, false);
+        for (const Slot& s : slots)
+            storeAttr(sink, i, s.attr, readScalar(rec + s.offset, s.type, false), s.type, hasN, false);
         if (rgbOffset >= 0) {
             uint32_t packed;  // 0x00RRGGBB whatever the declared type (F or U)
             std::memcpy(&packed, rec + rgbOffset, 4);
@@ -361,7 +378,8 @@ PointCloud loadPcd(const std::string& file) {
     }
     sink.finish(file, cloud);
     const double vp[3] = {h.viewpoint[0], h.viewpoint[1], h.viewpoint[2]};
-    cloud.viewpoint = Vec3f(float(vp[0] - cloud.origin[0]), float(vp[1] - cloud.origin[1]), float(vp[2] - cloud.origin[2]));
+    cloud.viewpoint =
+        Vec3f(float(vp[0] - cloud.origin[0]), float(vp[1] - cloud.origin[1]), float(vp[2] - cloud.origin[2]));
     cloud.hasViewpoint = true;
     return cloud;
 }

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
+#include <tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,8 +14,6 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include <tbb/parallel_for.h>
 
 #include "core/util/error.h"
 #include "core/util/input_file.h"
@@ -52,10 +51,18 @@ MappedFile::~MappedFile() {
 
 int typeSize(ScalarType t) {
     switch (t) {
-        case ScalarType::I8: case ScalarType::U8: return 1;
-        case ScalarType::I16: case ScalarType::U16: return 2;
-        case ScalarType::I32: case ScalarType::U32: case ScalarType::F32: return 4;
-        case ScalarType::F64: return 8;
+        case ScalarType::I8:
+        case ScalarType::U8:
+            return 1;
+        case ScalarType::I16:
+        case ScalarType::U16:
+            return 2;
+        case ScalarType::I32:
+        case ScalarType::U32:
+        case ScalarType::F32:
+            return 4;
+        case ScalarType::F64:
+            return 8;
     }
     return 0;
 }
@@ -81,14 +88,40 @@ double readScalar(const char* p, ScalarType t, bool bigEndian) {
     unsigned char b[8];
     std::memcpy(b, &bits, 8);
     switch (t) {
-        case ScalarType::I8: return double(int8_t(b[0]));
-        case ScalarType::U8: return double(b[0]);
-        case ScalarType::I16: { int16_t v; std::memcpy(&v, b, 2); return v; }
-        case ScalarType::U16: { uint16_t v; std::memcpy(&v, b, 2); return v; }
-        case ScalarType::I32: { int32_t v; std::memcpy(&v, b, 4); return v; }
-        case ScalarType::U32: { uint32_t v; std::memcpy(&v, b, 4); return v; }
-        case ScalarType::F32: { float v; std::memcpy(&v, b, 4); return v; }
-        case ScalarType::F64: { double v; std::memcpy(&v, b, 8); return v; }
+        case ScalarType::I8:
+            return double(int8_t(b[0]));
+        case ScalarType::U8:
+            return double(b[0]);
+        case ScalarType::I16: {
+            int16_t v;
+            std::memcpy(&v, b, 2);
+            return v;
+        }
+        case ScalarType::U16: {
+            uint16_t v;
+            std::memcpy(&v, b, 2);
+            return v;
+        }
+        case ScalarType::I32: {
+            int32_t v;
+            std::memcpy(&v, b, 4);
+            return v;
+        }
+        case ScalarType::U32: {
+            uint32_t v;
+            std::memcpy(&v, b, 4);
+            return v;
+        }
+        case ScalarType::F32: {
+            float v;
+            std::memcpy(&v, b, 4);
+            return v;
+        }
+        case ScalarType::F64: {
+            double v;
+            std::memcpy(&v, b, 8);
+            return v;
+        }
     }
     return 0;
 }
@@ -96,14 +129,29 @@ double readScalar(const char* p, ScalarType t, bool bigEndian) {
 // Which per-point attribute a property name feeds.
 Attr attrOf(const std::string& name) {
     static const std::pair<const char*, Attr> table[] = {
-        {"x", Attr::X}, {"y", Attr::Y}, {"z", Attr::Z},
-        {"nx", Attr::NX}, {"ny", Attr::NY}, {"nz", Attr::NZ},
-        {"normal_x", Attr::NX}, {"normal_y", Attr::NY}, {"normal_z", Attr::NZ},
-        {"red", Attr::R}, {"green", Attr::G}, {"blue", Attr::B},
-        {"r", Attr::R}, {"g", Attr::G}, {"b", Attr::B},
-        {"diffuse_red", Attr::R}, {"diffuse_green", Attr::G}, {"diffuse_blue", Attr::B},
-        {"radius", Attr::Radius}, {"scale", Attr::Radius}, {"point_size", Attr::Radius},
-        {"intensity", Attr::Intensity}, {"scalar_intensity", Attr::Intensity},
+        {"x", Attr::X},
+        {"y", Attr::Y},
+        {"z", Attr::Z},
+        {"nx", Attr::NX},
+        {"ny", Attr::NY},
+        {"nz", Attr::NZ},
+        {"normal_x", Attr::NX},
+        {"normal_y", Attr::NY},
+        {"normal_z", Attr::NZ},
+        {"red", Attr::R},
+        {"green", Attr::G},
+        {"blue", Attr::B},
+        {"r", Attr::R},
+        {"g", Attr::G},
+        {"b", Attr::B},
+        {"diffuse_red", Attr::R},
+        {"diffuse_green", Attr::G},
+        {"diffuse_blue", Attr::B},
+        {"radius", Attr::Radius},
+        {"scale", Attr::Radius},
+        {"point_size", Attr::Radius},
+        {"intensity", Attr::Intensity},
+        {"scalar_intensity", Attr::Intensity},
     };
     for (const auto& [n, a] : table)
         if (name == n) return a;
@@ -111,8 +159,10 @@ Attr attrOf(const std::string& name) {
 }
 
 uint8_t colorByte(double v, ScalarType t) {
-    if (t == ScalarType::F32 || t == ScalarType::F64) v *= 255.0;
-    else if (t == ScalarType::U16) v /= 257.0;
+    if (t == ScalarType::F32 || t == ScalarType::F64)
+        v *= 255.0;
+    else if (t == ScalarType::U16)
+        v /= 257.0;
     if (!(v > 0)) return 0;
     return uint8_t(std::min(255.0, std::round(v)));
 }
@@ -161,7 +211,9 @@ void PointSink::finish(const std::string& file, PointCloud& out) {
     for (size_t b = 0; b < blocks; ++b) start[b + 1] += start[b];
     const size_t kept = start[blocks];
     out.droppedNonFinite = n - kept;
-    if (kept == 0) throw Error(file, n == 0 ? "empty point cloud" : "no point with finite coordinates (all NaN, inf or beyond 1e18)");
+    if (kept == 0)
+        throw Error(file,
+                    n == 0 ? "empty point cloud" : "no point with finite coordinates (all NaN, inf or beyond 1e18)");
     resizeHuge(out.positions, kept);
     if (!nrm.empty()) resizeHuge(out.normals, kept);
     if (!col.empty()) out.colors.resize(kept);
@@ -254,10 +306,14 @@ PlyHeader parsePlyHeader(const MappedFile& f) {
         if (kw == "format") {
             std::string fmt, ver;
             ls >> fmt >> ver;
-            if (fmt == "ascii") h.format = PlyFormat::Ascii;
-            else if (fmt == "binary_little_endian") h.format = PlyFormat::BinaryLE;
-            else if (fmt == "binary_big_endian") h.format = PlyFormat::BinaryBE;
-            else throw Error(file, "unknown PLY format '" + fmt + "'");
+            if (fmt == "ascii")
+                h.format = PlyFormat::Ascii;
+            else if (fmt == "binary_little_endian")
+                h.format = PlyFormat::BinaryLE;
+            else if (fmt == "binary_big_endian")
+                h.format = PlyFormat::BinaryBE;
+            else
+                throw Error(file, "unknown PLY format '" + fmt + "'");
             haveFormat = true;
         } else if (kw == "element") {
             PlyElement e;
@@ -342,7 +398,8 @@ size_t fixedSize(const PlyElement& e) {
 size_t skipBinary(const MappedFile& f, size_t off, const PlyElement& e, bool be) {
     const size_t fs = fixedSize(e);
     if (fs > 0) {
-        if (e.count > (f.size - off) / fs) throw Error(f.name, "PLY element '" + e.name + "' runs past the end of the file");
+        if (e.count > (f.size - off) / fs)
+            throw Error(f.name, "PLY element '" + e.name + "' runs past the end of the file");
         return off + fs * e.count;
     }
     for (uint64_t i = 0; i < e.count; ++i) {
@@ -373,7 +430,9 @@ std::optional<PointFileInfo> probePly(const std::string& file) {
     const PlyElement* faces = findElement(h, "face");
     if (!v || (faces && faces->count > 0)) return std::nullopt;
     PointFileInfo info;
-    info.format = h.format == PlyFormat::Ascii ? "ply ascii" : h.format == PlyFormat::BinaryLE ? "ply binary_little_endian" : "ply binary_big_endian";
+    info.format = h.format == PlyFormat::Ascii      ? "ply ascii"
+                  : h.format == PlyFormat::BinaryLE ? "ply binary_little_endian"
+                                                    : "ply binary_big_endian";
     info.points = v->count;
     for (const auto& p : v->props) info.properties.push_back(p.name);
     return info;
@@ -381,18 +440,41 @@ std::optional<PointFileInfo> probePly(const std::string& file) {
 
 void detail::storeAttr(PointSink& sink, size_t i, Attr a, double x, ScalarType type, bool hasN, bool hasC) {
     switch (a) {
-        case Attr::X: sink.pos[i][0] = x; break;
-        case Attr::Y: sink.pos[i][1] = x; break;
-        case Attr::Z: sink.pos[i][2] = x; break;
-        case Attr::NX: if (hasN) sink.nrm[i].x = float(x); break;
-        case Attr::NY: if (hasN) sink.nrm[i].y = float(x); break;
-        case Attr::NZ: if (hasN) sink.nrm[i].z = float(x); break;
-        case Attr::R: if (hasC) sink.col[i][0] = colorByte(x, type); break;
-        case Attr::G: if (hasC) sink.col[i][1] = colorByte(x, type); break;
-        case Attr::B: if (hasC) sink.col[i][2] = colorByte(x, type); break;
-        case Attr::Radius: sink.rad[i] = float(x); break;
-        case Attr::Intensity: sink.inten[i] = float(x); break;
-        default: break;
+        case Attr::X:
+            sink.pos[i][0] = x;
+            break;
+        case Attr::Y:
+            sink.pos[i][1] = x;
+            break;
+        case Attr::Z:
+            sink.pos[i][2] = x;
+            break;
+        case Attr::NX:
+            if (hasN) sink.nrm[i].x = float(x);
+            break;
+        case Attr::NY:
+            if (hasN) sink.nrm[i].y = float(x);
+            break;
+        case Attr::NZ:
+            if (hasN) sink.nrm[i].z = float(x);
+            break;
+        case Attr::R:
+            if (hasC) sink.col[i][0] = colorByte(x, type);
+            break;
+        case Attr::G:
+            if (hasC) sink.col[i][1] = colorByte(x, type);
+            break;
+        case Attr::B:
+            if (hasC) sink.col[i][2] = colorByte(x, type);
+            break;
+        case Attr::Radius:
+            sink.rad[i] = float(x);
+            break;
+        case Attr::Intensity:
+            sink.inten[i] = float(x);
+            break;
+        default:
+            break;
     }
 }
 
@@ -414,7 +496,8 @@ PointCloud loadPly(const std::string& file) {
     size_t off = 0;
     for (const auto& p : v->props) {
         if (p.isList) {
-            if (h.format != PlyFormat::Ascii) throw Error(file, "list properties in the vertex element are not supported");
+            if (h.format != PlyFormat::Ascii)
+                throw Error(file, "list properties in the vertex element are not supported");
         } else {
             const Attr a = attrOf(p.name);
             if (a != Attr::None && !has[int(a)]) {
@@ -424,9 +507,12 @@ PointCloud loadPly(const std::string& file) {
             off += size_t(typeSize(p.type));
         }
     }
-    if (!has[int(Attr::X)] || !has[int(Attr::Y)] || !has[int(Attr::Z)]) throw Error(file, "PLY vertices lack x, y or z");
+    if (!has[int(Attr::X)] || !has[int(Attr::Y)] || !has[int(Attr::Z)])
+        throw Error(file, "PLY vertices lack x, y or z");
     PointCloud cloud;
-    cloud.format = h.format == PlyFormat::Ascii ? "ply ascii" : be ? "ply binary_big_endian" : "ply binary_little_endian";
+    cloud.format = h.format == PlyFormat::Ascii ? "ply ascii"
+                   : be                         ? "ply binary_big_endian"
+                                                : "ply binary_little_endian";
     for (const auto& p : v->props) cloud.properties.push_back(p.name);
     const bool hasN = has[int(Attr::NX)] && has[int(Attr::NY)] && has[int(Attr::NZ)];
     const bool hasC = has[int(Attr::R)] && has[int(Attr::G)] && has[int(Attr::B)];
@@ -437,14 +523,18 @@ PointCloud loadPly(const std::string& file) {
         // Each value takes at least two bytes ("0 "): a cheap bound before allocating.
         const size_t remaining = f.size - h.bodyOffset;
         if (v->count > remaining / std::max<size_t>(2 * v->props.size(), 2))
-            throw Error(file, "PLY header declares " + std::to_string(v->count) + " vertices but the file is too small");
+            throw Error(file,
+                        "PLY header declares " + std::to_string(v->count) + " vertices but the file is too small");
         Tokens tk{f.data + h.bodyOffset, f.data + f.size};
         for (const auto& e : h.elements) {
             if (&e == v) break;
             if (e.count > remaining / 2) throw Error(file, "PLY element '" + e.name + "' count exceeds the file size");
             for (uint64_t i = 0; i < e.count; ++i)
                 for (const auto& p : e.props) {
-                    if (!p.isList) { tk.number(file); continue; }
+                    if (!p.isList) {
+                        tk.number(file);
+                        continue;
+                    }
                     const double c = tk.number(file);
                     if (!(c >= 0) || c > double(remaining)) throw Error(file, "bad list length in PLY body");
                     for (size_t j = 0; j < size_t(c); ++j) tk.number(file);
@@ -482,7 +572,8 @@ PointCloud loadPly(const std::string& file) {
         if (stride == 0) throw Error(file, "PLY vertex element has no fixed-size layout");
         if (v->count > (f.size - pos) / stride)
             throw Error(file, "PLY header declares " + std::to_string(v->count) + " vertices (" +
-                                  std::to_string(v->count * stride) + " bytes) but only " + std::to_string(f.size - pos) +
+                                  std::to_string(v->count * stride) + " bytes) but only " +
+                                  std::to_string(f.size - pos) +
                                   " bytes follow the header (truncated or lying header)");
         sink.reserve(file, n, hasN, hasC, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
         const char* base = f.data + pos;
@@ -509,7 +600,8 @@ PointCloud loadPly(const std::string& file) {
 }
 
 void writePly(const std::string& file, const PointCloud& c) {
-    const bool hasN = c.normals.size() == c.size(), hasC = c.colors.size() == c.size(), hasR = c.radii.size() == c.size();
+    const bool hasN = c.normals.size() == c.size(), hasC = c.colors.size() == c.size(),
+               hasR = c.radii.size() == c.size();
     const std::string tmp = file + ".tmp";
     {
         std::ofstream out(tmp, std::ios::binary);
@@ -557,13 +649,15 @@ TriangleMesh loadPlyMesh(const std::string& file) {
     if (fe->count > remaining / 2) throw Error(file, "PLY face count exceeds the file size");
     int listIdx = -1;
     for (size_t i = 0; i < fe->props.size(); ++i)
-        if (fe->props[i].isList && (fe->props[i].name == "vertex_indices" || fe->props[i].name == "vertex_index")) listIdx = int(i);
+        if (fe->props[i].isList && (fe->props[i].name == "vertex_indices" || fe->props[i].name == "vertex_index"))
+            listIdx = int(i);
     if (listIdx < 0) throw Error(file, "PLY faces have no vertex_indices list");
     m.triangles.reserve(size_t(fe->count));
     auto addPoly = [&](const std::vector<double>& idx) {
         for (double d : idx)
             if (!(d >= 0 && d < double(m.vertices.size()))) throw Error(file, "face index out of range");
-        for (size_t j = 2; j < idx.size(); ++j) m.triangles.push_back({uint32_t(idx[0]), uint32_t(idx[j - 1]), uint32_t(idx[j])});
+        for (size_t j = 2; j < idx.size(); ++j)
+            m.triangles.push_back({uint32_t(idx[0]), uint32_t(idx[j - 1]), uint32_t(idx[j])});
     };
     std::vector<double> idx;
     if (h.format == PlyFormat::Ascii) {
@@ -573,7 +667,10 @@ TriangleMesh loadPlyMesh(const std::string& file) {
             for (uint64_t i = 0; i < e.count; ++i)
                 for (size_t pi = 0; pi < e.props.size(); ++pi) {
                     const auto& p = e.props[pi];
-                    if (!p.isList) { tk.number(file); continue; }
+                    if (!p.isList) {
+                        tk.number(file);
+                        continue;
+                    }
                     const double c = tk.number(file);
                     if (!(c >= 0) || c > double(remaining)) throw Error(file, "bad list length in PLY body");
                     idx.clear();

@@ -12,16 +12,16 @@ namespace rtfact::points {
 
 struct PointCloud {
     std::vector<Vec3f> positions;
-    std::vector<Vec3f> normals;                   // empty: none in the file
-    std::vector<std::array<uint8_t, 3>> colors;   // empty: none
-    std::vector<float> radii;                     // empty: none
-    std::vector<float> intensities;               // empty: none
-    std::array<double, 3> origin{0, 0, 0};        // subtracted (in double) from the file's coordinates
-    Vec3f viewpoint{0, 0, 0};                     // sensor position (PCD VIEWPOINT), after the shift
+    std::vector<Vec3f> normals;                  // empty: none in the file
+    std::vector<std::array<uint8_t, 3>> colors;  // empty: none
+    std::vector<float> radii;                    // empty: none
+    std::vector<float> intensities;              // empty: none
+    std::array<double, 3> origin{0, 0, 0};       // subtracted (in double) from the file's coordinates
+    Vec3f viewpoint{0, 0, 0};                    // sensor position (PCD VIEWPOINT), after the shift
     bool hasViewpoint = false;
-    size_t droppedNonFinite = 0;                  // points with NaN/inf (or beyond 1e18) coordinates dropped on load
-    std::string format;                           // e.g. "ply binary_little_endian"
-    std::vector<std::string> properties;          // property names found in the file
+    size_t droppedNonFinite = 0;          // points with NaN/inf (or beyond 1e18) coordinates dropped on load
+    std::string format;                   // e.g. "ply binary_little_endian"
+    std::vector<std::string> properties;  // property names found in the file
 
     size_t size() const { return positions.size(); }
     AABB bounds() const {

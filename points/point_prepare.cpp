@@ -1,17 +1,18 @@
 // PCL lives here and in pcd_io.cpp only.
+#include "points/point_prepare.h"
+
 #include <pcl/console/print.h>
 #include <pcl/features/normal_3d_omp.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
-
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <chrono>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <thread>
 
@@ -19,7 +20,6 @@
 #include "core/util/memory_budget.h"
 #include "core/util/progress.h"
 #include "points/huge_pages.h"
-#include "points/point_prepare.h"
 
 namespace rtfact::points {
 
@@ -105,7 +105,8 @@ std::vector<Vec3f> normalsOfDistinct(const std::vector<Vec3f>& positions, int k,
     }
     auto cloud = toPcl(positions);
     pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // no PCL chatter on stderr
-    pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne(threads > 0 ? threads : int(std::thread::hardware_concurrency()));
+    pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> ne(threads > 0 ? threads
+                                                                        : int(std::thread::hardware_concurrency()));
     ne.setInputCloud(cloud);
     ne.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
     ne.setKSearch(std::max(3, std::min<int>(k, int(positions.size()))));
@@ -162,8 +163,10 @@ uint64_t pointPipelineBytes(uint64_t n, bool estimateNormals, bool estimateRadii
     // k-NN (PointXYZ + FLANN tree) about half of that. Collapsing duplicates before
     // either keeps a slot per point and a copy of the distinct positions (16 B).
     uint64_t perPoint = 72;
-    if (estimateNormals) perPoint += 48;
-    else if (estimateRadii) perPoint += 24;
+    if (estimateNormals)
+        perPoint += 48;
+    else if (estimateRadii)
+        perPoint += 24;
     if (estimateNormals || estimateRadii) perPoint += 16;
     return n * perPoint;
 }
@@ -188,7 +191,8 @@ PrepareReport preparePointCloud(PointCloud& cloud, const PrepareOptions& opt, co
     const std::vector<Vec3f>& searched = distinct.of(cloud.positions);
     if (estimateN) {
         Progress progress("normals", 1, progressEnabled());
-        const Vec3f vp = cloud.hasViewpoint ? cloud.viewpoint : opt.viewpoint.value_or(cloud.bounds().center() + Vec3f(0, 0, 1e3f));
+        const Vec3f vp =
+            cloud.hasViewpoint ? cloud.viewpoint : opt.viewpoint.value_or(cloud.bounds().center() + Vec3f(0, 0, 1e3f));
         cloud.normals = distinct.expand(normalsOfDistinct(searched, opt.normalK, vp, opt.threads));
         progress.finish();
         rep.normalsMs = msSince(t0);
@@ -250,8 +254,10 @@ std::vector<Disc> makeDiscs(const PointCloud& c, ColorMode mode) {
             d[i].radius = c.radii.size() == n ? c.radii[i] : 0.0f;
             d[i].normal = encodeNormal(c.normals.size() == n ? c.normals[i] : Vec3f(0, 0, 1));
             Vec3f col(0.85f, 0.85f, 0.85f);
-            if (mode == ColorMode::Rgb && hasC) col = Vec3f(c.colors[i][0], c.colors[i][1], c.colors[i][2]) * (1.0f / 255.0f);
-            else if (mode == ColorMode::Intensity && hasI) col = Vec3f((c.intensities[i] - iLo) / (iHi - iLo));
+            if (mode == ColorMode::Rgb && hasC)
+                col = Vec3f(c.colors[i][0], c.colors[i][1], c.colors[i][2]) * (1.0f / 255.0f);
+            else if (mode == ColorMode::Intensity && hasI)
+                col = Vec3f((c.intensities[i] - iLo) / (iHi - iLo));
             else if (mode == ColorMode::Intensity && hasC)
                 col = Vec3f((0.299f * c.colors[i][0] + 0.587f * c.colors[i][1] + 0.114f * c.colors[i][2]) / 255.0f);
             d[i].rgba = packRGBA(col, 0);

@@ -14,11 +14,11 @@
 namespace rtfact::points {
 
 struct PrepareOptions {
-    std::string normals = "auto";  // auto: from the file if present, else estimate | estimate | file
-    int normalK = 24;  // noisy depth sensors need a wide neighbourhood
-    float radius = 0.0f;        // > 0: the same radius for every point
-    float radiusFactor = 1.0f;  // times the spacing estimate (or times the file's radii)
-    int radiusK = 4;            // neighbour whose distance is the spacing
+    std::string normals = "auto";    // auto: from the file if present, else estimate | estimate | file
+    int normalK = 24;                // noisy depth sensors need a wide neighbourhood
+    float radius = 0.0f;             // > 0: the same radius for every point
+    float radiusFactor = 1.0f;       // times the spacing estimate (or times the file's radii)
+    int radiusK = 4;                 // neighbour whose distance is the spacing
     std::optional<Vec3f> viewpoint;  // where normals should face when there is no sensor position
     int threads = 0;                 // 0: all cores
 };

@@ -17,7 +17,7 @@ namespace rtfact::points {
 // Distinct colours for LoD levels: 0 = input points (grey), then blue..red as the
 // representative covers larger subtrees.
 inline Vec3f lodLevelColor(int level) {
-    static const Vec3f pal[] = {{0.75f, 0.75f, 0.75f}, {0.2f, 0.35f, 1.0f}, {0.1f, 0.8f, 0.9f}, {0.2f, 0.85f, 0.3f},
+    static const Vec3f pal[] = {{0.75f, 0.75f, 0.75f}, {0.2f, 0.35f, 1.0f}, {0.1f, 0.8f, 0.9f},  {0.2f, 0.85f, 0.3f},
                                 {0.9f, 0.9f, 0.2f},    {1.0f, 0.55f, 0.1f}, {1.0f, 0.15f, 0.1f}, {0.9f, 0.2f, 0.9f}};
     return pal[std::min(level, 7)];
 }
@@ -66,9 +66,15 @@ struct PointScene {
             Vec3f nn = d.n();
             Vec3f c;
             switch (colorMode) {
-                case ColorMode::Normal: c = nn * 0.5f + Vec3f(0.5f); break;
-                case ColorMode::Lod: c = lodLevelColor(id < 0 ? d.level() : 0); break;
-                default: c = unpackRGB(d.rgba); break;
+                case ColorMode::Normal:
+                    c = nn * 0.5f + Vec3f(0.5f);
+                    break;
+                case ColorMode::Lod:
+                    c = lodLevelColor(id < 0 ? d.level() : 0);
+                    break;
+                default:
+                    c = unpackRGB(d.rgba);
+                    break;
             }
             if (dot(nn, rays.dir.lane(i)) > 0) nn = -nn;
             n.setLane(i, nn);

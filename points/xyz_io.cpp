@@ -28,8 +28,10 @@ bool parseLine(const char* p, const char* end, std::vector<double>& vals) {
         auto [q, ec] = std::from_chars(s, p, v);
         if (ec != std::errc{} || q != p) {
             const std::string_view t(s, size_t(p - s));
-            if (t == "nan" || t == "NaN" || t == "-nan" || t == "inf" || t == "-inf") v = std::nan("");
-            else return false;
+            if (t == "nan" || t == "NaN" || t == "-nan" || t == "inf" || t == "-inf")
+                v = std::nan("");
+            else
+                return false;
         }
         vals.push_back(v);
     }
@@ -66,7 +68,8 @@ XyzLayout detect(const MappedFile& f) {
             L.declared = uint64_t(vals[0]);
             if (L.declared == 0) throw Error(f.name, "empty point cloud (count 0)");
             if (L.declared > (f.size - pos) / 6)
-                throw Error(f.name, "PTS header declares " + std::to_string(L.declared) + " points but the file is too small");
+                throw Error(f.name,
+                            "PTS header declares " + std::to_string(L.declared) + " points but the file is too small");
             continue;
         }
         if (vals.size() < 3) throw Error(f.name, "line " + std::to_string(lineNo) + " has fewer than 3 values");
@@ -100,12 +103,17 @@ PointCloud loadXyz(const std::string& file) {
     parseLine(f.data + L.firstLine, std::find(f.data + L.firstLine, f.data + f.size, '\n'), vals);
     bool normals = false, colors = false, intensity = false;
     size_t nOff = 0, cOff = 0, iOff = 0;
-    if (cols == 4) intensity = true, iOff = 3;
+    if (cols == 4)
+        intensity = true, iOff = 3;
     else if (cols == 6) {
-        if (std::fabs(vals[3]) <= 1 && std::fabs(vals[4]) <= 1 && std::fabs(vals[5]) <= 1) normals = true, nOff = 3;
-        else colors = true, cOff = 3;
-    } else if (cols == 7) intensity = true, iOff = 3, colors = true, cOff = 4;
-    else if (cols >= 9) normals = true, nOff = 3, colors = true, cOff = 6;
+        if (std::fabs(vals[3]) <= 1 && std::fabs(vals[4]) <= 1 && std::fabs(vals[5]) <= 1)
+            normals = true, nOff = 3;
+        else
+            colors = true, cOff = 3;
+    } else if (cols == 7)
+        intensity = true, iOff = 3, colors = true, cOff = 4;
+    else if (cols >= 9)
+        normals = true, nOff = 3, colors = true, cOff = 6;
     PointCloud cloud;
     cloud.format = L.pts ? "pts text" : "xyz text";
     cloud.properties = {"x", "y", "z"};
@@ -127,11 +135,13 @@ PointCloud loadXyz(const std::string& file) {
             throw Error(file, "data line " + std::to_string(lineNo) + " is not a list of numbers");
         if (vals.empty()) continue;
         if (vals.size() != cols)
-            throw Error(file, "data line " + std::to_string(lineNo) + " has " + std::to_string(vals.size()) + " values, expected " +
-                                  std::to_string(cols));
+            throw Error(file, "data line " + std::to_string(lineNo) + " has " + std::to_string(vals.size()) +
+                                  " values, expected " + std::to_string(cols));
         sink.pos.push_back({vals[0], vals[1], vals[2]});
         if (normals) sink.nrm.push_back(Vec3f(float(vals[nOff]), float(vals[nOff + 1]), float(vals[nOff + 2])));
-        if (colors) sink.col.push_back({colorByte(vals[cOff], ScalarType::U8), colorByte(vals[cOff + 1], ScalarType::U8), colorByte(vals[cOff + 2], ScalarType::U8)});
+        if (colors)
+            sink.col.push_back({colorByte(vals[cOff], ScalarType::U8), colorByte(vals[cOff + 1], ScalarType::U8),
+                                colorByte(vals[cOff + 2], ScalarType::U8)});
         if (intensity) sink.inten.push_back(float(vals[iOff]));
     }
     if (L.pts && sink.pos.size() != L.declared)

@@ -38,9 +38,11 @@ void Mesh::validate() const {
     const uint32_t nv = uint32_t(positions.size());
     for (uint32_t i : indices)
         if (i >= nv) throw Error(source, "face refers to vertex " + std::to_string(i) + " of " + std::to_string(nv));
-    if (!normals.empty() && normals.size() != positions.size()) throw Error(source, "normal count differs from vertex count");
+    if (!normals.empty() && normals.size() != positions.size())
+        throw Error(source, "normal count differs from vertex count");
     if (!uvs.empty() && uvs.size() != 2 * positions.size()) throw Error(source, "uv count differs from vertex count");
-    if (!colors.empty() && colors.size() != positions.size()) throw Error(source, "colour count differs from vertex count");
+    if (!colors.empty() && colors.size() != positions.size())
+        throw Error(source, "colour count differs from vertex count");
     if (!materialIds.empty()) {
         if (materialIds.size() != triangles()) throw Error(source, "material id count differs from triangle count");
         for (int32_t m : materialIds)

@@ -19,19 +19,19 @@ struct MeshMaterial {
     float ior = 1.0f;            // index of refraction (Ni)
     float dissolve = 1.0f;       // opacity (d); < 1 means glass-like
     int illum = 2;
-    std::string diffuseMap;      // map_Kd, resolved to a path next to the MTL file
+    std::string diffuseMap;  // map_Kd, resolved to a path next to the MTL file
 };
 
 struct Mesh {
-    std::string source;                 // file it came from
+    std::string source;  // file it came from
     std::vector<Vec3f> positions;
-    std::vector<Vec3f> normals;         // per vertex, empty or positions.size()
-    std::vector<float> uvs;             // 2 per vertex, empty or 2 * positions.size()
-    std::vector<Vec3f> colors;          // per vertex in [0,1], empty or positions.size()
-    std::vector<uint32_t> indices;      // 3 per triangle
-    std::vector<int32_t> materialIds;   // per triangle, empty or triangles()
+    std::vector<Vec3f> normals;        // per vertex, empty or positions.size()
+    std::vector<float> uvs;            // 2 per vertex, empty or 2 * positions.size()
+    std::vector<Vec3f> colors;         // per vertex in [0,1], empty or positions.size()
+    std::vector<uint32_t> indices;     // 3 per triangle
+    std::vector<int32_t> materialIds;  // per triangle, empty or triangles()
     std::vector<MeshMaterial> materials;
-    bool normalsComputed = false;       // true when the file had none
+    bool normalsComputed = false;  // true when the file had none
 
     size_t triangles() const { return indices.size() / 3; }
     AABB bounds() const;

@@ -1,6 +1,20 @@
 // All VTK includes of the surfaces library live in this file.
 #include "surfaces/mesh_loader.h"
 
+#include <vtkCallbackCommand.h>
+#include <vtkCellArray.h>
+#include <vtkDataArray.h>
+#include <vtkExecutive.h>
+#include <vtkLogger.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataReader.h>
+#include <vtkSTLReader.h>
+#include <vtkSmartPointer.h>
+#include <vtkStringOutputWindow.h>
+#include <vtkXMLPolyDataReader.h>
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -10,20 +24,6 @@
 #include <fstream>
 #include <sstream>
 #include <unordered_map>
-
-#include <vtkCallbackCommand.h>
-#include <vtkCellArray.h>
-#include <vtkDataArray.h>
-#include <vtkExecutive.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
-#include <vtkPolyDataReader.h>
-#include <vtkSTLReader.h>
-#include <vtkSmartPointer.h>
-#include <vtkLogger.h>
-#include <vtkStringOutputWindow.h>
-#include <vtkXMLPolyDataReader.h>
 
 #include "core/util/error.h"
 #include "core/util/input_file.h"
@@ -144,8 +144,7 @@ uint64_t meshBytes(uint64_t vertices, uint64_t triangles, uint64_t fileCopy) {
 }
 
 void checkMeshMemory(const std::string& file, uint64_t vertices, uint64_t triangles, uint64_t fileCopy) {
-    checkMemory(file, meshBytes(vertices, triangles, fileCopy),
-                std::to_string(triangles) + " triangles and their BVH",
+    checkMemory(file, meshBytes(vertices, triangles, fileCopy), std::to_string(triangles) + " triangles and their BVH",
                 "simplify the mesh, e.g. with vtkQuadricDecimation");
 }
 
@@ -167,7 +166,7 @@ void checkStl(const std::string& file) {
             throw Error(file, "truncated or lying binary STL: " + std::to_string(n) + " triangles need " +
                                   std::to_string(need) + " bytes, file has " + std::to_string(size));
         if (!asciiMagic) checkMeshMemory(file, 3ull * n, n, 0);  // VTK keeps unmerged points first
-        if (asciiMagic && need == size) return;  // binary file whose comment starts with "solid"
+        if (asciiMagic && need == size) return;                  // binary file whose comment starts with "solid"
     }
     if (asciiMagic && size > 0) {
         // ASCII STL: VTK parses it line by line, nothing to pre-allocate.
@@ -277,10 +276,14 @@ std::vector<MeshMaterial> readMtl(const std::string& file) {
             (kw == "Kd" ? m.kd : kw == "Ks" ? m.ks : m.ke) = {v[0], v[1], v[2]};
         } else if (kw == "Ns" || kw == "Ni" || kw == "d" || kw == "Tr") {
             if (!parseFloats(rest, v, 1) || !std::isfinite(v[0])) bad("expected a number after " + kw);
-            if (kw == "Ns") m.ns = v[0];
-            else if (kw == "Ni") m.ior = v[0];
-            else if (kw == "d") m.dissolve = v[0];
-            else m.dissolve = 1.0f - v[0];
+            if (kw == "Ns")
+                m.ns = v[0];
+            else if (kw == "Ni")
+                m.ior = v[0];
+            else if (kw == "d")
+                m.dissolve = v[0];
+            else
+                m.dissolve = 1.0f - v[0];
         } else if (kw == "illum") {
             if (!parseFloats(rest, v, 1)) bad("expected a number after illum");
             m.illum = int(v[0]);
@@ -307,7 +310,9 @@ Mesh readObj(const std::string& file) {
         bool operator==(const Key&) const = default;
     };
     struct KeyHash {
-        size_t operator()(const Key& k) const { return size_t(k.p) * 73856093u ^ size_t(k.t) * 19349663u ^ size_t(k.n) * 83492791u; }
+        size_t operator()(const Key& k) const {
+            return size_t(k.p) * 73856093u ^ size_t(k.t) * 19349663u ^ size_t(k.n) * 83492791u;
+        }
     };
     std::unordered_map<Key, uint32_t, KeyHash> remap;
     std::vector<Key> keys;
@@ -348,10 +353,12 @@ Mesh readObj(const std::string& file) {
                 size_t pos = 0;
                 for (int c = 0; c < 3 && pos <= tok.size(); ++c) {
                     const size_t slash = tok.find('/', pos);
-                    const std::string part = tok.substr(pos, slash == std::string::npos ? std::string::npos : slash - pos);
+                    const std::string part =
+                        tok.substr(pos, slash == std::string::npos ? std::string::npos : slash - pos);
                     if (!part.empty()) {
                         auto r = std::from_chars(part.data(), part.data() + part.size(), idx[c]);
-                        if (r.ec != std::errc() || r.ptr != part.data() + part.size()) bad("bad face index '" + tok + "'");
+                        if (r.ec != std::errc() || r.ptr != part.data() + part.size())
+                            bad("bad face index '" + tok + "'");
                         const int count = c == 0 ? int(v.size()) : c == 1 ? int(vt.size() / 2) : int(vn.size());
                         // 1-based, negative counts from the end.
                         idx[c] = idx[c] < 0 ? count + idx[c] + 1 : idx[c];
@@ -412,7 +419,8 @@ Mesh readObj(const std::string& file) {
         if (needDefault) {
             const int d = int(m.materials.size());
             m.materials.push_back({});
-            for (int32_t& x : m.materialIds) if (x < 0) x = d;
+            for (int32_t& x : m.materialIds)
+                if (x < 0) x = d;
         }
     }
     if (m.indices.empty() && !v.empty()) throw Error(file, "OBJ file has vertices but no faces");

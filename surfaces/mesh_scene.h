@@ -2,14 +2,14 @@
 // with the generic packet intersectors around TriangleIntersector. Every core integrator
 // (eyelight, direct light) and the surface integrators of this library render it.
 #pragma once
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <atomic>
 #include <chrono>
 #include <memory>
 #include <type_traits>
 #include <vector>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "core/accel/bvh_intersector.h"
 #include "core/accel/in_place_sah_bvh_builder.h"
@@ -73,7 +73,7 @@ struct MeshScene {
     // When set, counts the rays the wide BVH answered: tests check that the wide path
     // really runs (null by default: one branch per query, no shared cache line).
     std::atomic<uint64_t>* wideRayCount = nullptr;
-    std::vector<Vec3f> materialColor;  // diffuse colour per material id
+    std::vector<Vec3f> materialColor;       // diffuse colour per material id
     std::vector<ImageTexture> diffuseMaps;  // per material id (image empty: none)
     AABB box;
     template <int N>
@@ -93,7 +93,9 @@ struct MeshScene {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
                 for (size_t i = r.begin(); i != r.end(); ++i) {
                     AABB b;
-                    b.extend(m.positions[m.indices[3 * i]]).extend(m.positions[m.indices[3 * i + 1]]).extend(m.positions[m.indices[3 * i + 2]]);
+                    b.extend(m.positions[m.indices[3 * i]])
+                        .extend(m.positions[m.indices[3 * i + 1]])
+                        .extend(m.positions[m.indices[3 * i + 2]]);
                     bounds[i] = b;
                 }
             });
@@ -103,12 +105,14 @@ struct MeshScene {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
                 for (size_t i = r.begin(); i != r.end(); ++i) {
                     const uint32_t t = accel.order[i];
-                    accel.elems[i] = {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]};
+                    accel.elems[i] = {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]],
+                                      m.positions[m.indices[3 * t + 2]]};
                 }
             });
             wide = {};
             if (buildWide) {
-                static_cast<WideBVHTopology<kMeshWideArity>&>(wide) = collapseBVH<kMeshWideArity>(static_cast<const BVHTopology&>(accel));
+                static_cast<WideBVHTopology<kMeshWideArity>&>(wide) =
+                    collapseBVH<kMeshWideArity>(static_cast<const BVHTopology&>(accel));
                 resizeHugePages(wide.elems, n);
                 tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
                     for (size_t i = r.begin(); i != r.end(); ++i) wide.elems[i] = accel.elems[i];
@@ -125,7 +129,8 @@ struct MeshScene {
             materialColor.push_back(mm.kd);
             ImageTexture t;
             // map_Kd images (meshes without uvs cannot use them).
-            if (!mm.diffuseMap.empty() && !mesh->uvs.empty()) t.image = std::make_shared<const Image>(readImage(mm.diffuseMap));
+            if (!mm.diffuseMap.empty() && !mesh->uvs.empty())
+                t.image = std::make_shared<const Image>(readImage(mm.diffuseMap));
             diffuseMaps.push_back(t);
         }
     }
@@ -208,7 +213,8 @@ struct MeshScene {
                 const int32_t mat = m.materialIds[t];
                 sp.material[i] = mat;
                 col = col * materialColor[size_t(mat)];
-                if (hasUV && diffuseMaps[size_t(mat)].image) col = col * diffuseMaps[size_t(mat)].sample(sp.u[i], sp.v[i]);
+                if (hasUV && diffuseMaps[size_t(mat)].image)
+                    col = col * diffuseMaps[size_t(mat)].sample(sp.u[i], sp.v[i]);
             }
             sp.color.setLane(i, col);
         });

@@ -13,8 +13,8 @@
 #include "core/concepts/scene.h"
 #include "core/render/random.h"
 #include "core/render/sampling.h"
-#include "surfaces/mesh.h"
 #include "core/render/secondary_rays.h"
+#include "surfaces/mesh.h"
 
 namespace rtfact {
 
@@ -46,7 +46,7 @@ template <SecondaryRayPolicy Secondary = WideSecondaryRays>
 struct PathIntegratorT {
     Vec3f background{0.0f};  // constant environment radiance
     int maxDepth = 6;
-    int rouletteDepth = 3;   // Russian roulette from this bounce on (unbiased)
+    int rouletteDepth = 3;                // Russian roulette from this bounce on (unbiased)
     std::vector<PathMaterial> materials;  // by material id; empty: one default Lambert
 
     template <int N, class Scene>
@@ -82,7 +82,8 @@ struct PathIntegratorT {
             Mask<N> below(false);  // continue on the far side of the surface
             BitMask<N>(found).forEach([&](int i) {
                 const int32_t mid = sp.material[i];
-                const PathMaterial& m = materials.empty() || mid < 0 || size_t(mid) >= materials.size() ? kDefault : materials[size_t(mid)];
+                const PathMaterial& m =
+                    materials.empty() || mid < 0 || size_t(mid) >= materials.size() ? kDefault : materials[size_t(mid)];
                 emitted.setLane(i, m.emission);
                 const Vec3f d = rays.dir.lane(i), n = sp.n.lane(i);
                 if (m.kind == PathMaterial::Lambert) {
@@ -126,7 +127,7 @@ struct PathIntegratorT {
             if (any(diffuse)) newDir = select(diffuse, cosineHemisphere(sp.n, u1, u2), newDir);
             // Directions below the geometric surface (shading-normal artefacts) end the path.
             const P side = dot(newDir, sp.ng);
-            alive = found & select(below, side < zero, side > zero);
+            alive = found & select(below, side<zero, side> zero);
             beta = beta * weight;
             if (depth >= rouletteDepth) {
                 const P q = min(P(0.95f), max(max(beta.x, beta.y), beta.z));

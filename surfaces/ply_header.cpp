@@ -83,10 +83,14 @@ PlyHeader readPlyHeader(const std::string& file) {
         if (kw == "format") {
             std::string f, v;
             ls >> f >> v;
-            if (f == "ascii") h.format = PlyHeader::Format::Ascii;
-            else if (f == "binary_little_endian") h.format = PlyHeader::Format::BinaryLE;
-            else if (f == "binary_big_endian") h.format = PlyHeader::Format::BinaryBE;
-            else throw Error(file, "unknown PLY format '" + f + "'");
+            if (f == "ascii")
+                h.format = PlyHeader::Format::Ascii;
+            else if (f == "binary_little_endian")
+                h.format = PlyHeader::Format::BinaryLE;
+            else if (f == "binary_big_endian")
+                h.format = PlyHeader::Format::BinaryBE;
+            else
+                throw Error(file, "unknown PLY format '" + f + "'");
             haveFormat = true;
         } else if (kw == "element") {
             PlyElement e;
@@ -136,8 +140,10 @@ PlyHeader readPlyHeader(const std::string& file) {
     for (const PlyElement& e : h.elements) {
         long double per = 0;
         for (const PlyProperty& p : e.props) {
-            if (h.format == PlyHeader::Format::Ascii) per += 2;
-            else per += p.isList ? p.countBytes : p.typeBytes;
+            if (h.format == PlyHeader::Format::Ascii)
+                per += 2;
+            else
+                per += p.isList ? p.countBytes : p.typeBytes;
         }
         need += per * (long double)e.count;
     }
@@ -174,8 +180,9 @@ uint64_t plyTriangleEstimate(const PlyHeader& h) {
         // ASCII: most indices of n vertices have about as many digits as n - 1 (the
         // vertices' own bytes count as 2 per value, so the rest is generous anyway).
         if (e.name == "tristrips" && idx)
-            stripIndexBytes = ascii ? 1 + std::max<int>(1, int(std::to_string(std::max<uint64_t>(h.count("vertex"), 1) - 1).size()))
-                                    : idx->typeBytes;
+            stripIndexBytes =
+                ascii ? 1 + std::max<int>(1, int(std::to_string(std::max<uint64_t>(h.count("vertex"), 1) - 1).size()))
+                      : idx->typeBytes;
         // The same minimum sizes as the header check: counts only for lists.
         uint64_t per = 0;
         for (const PlyProperty& p : e.props) per += ascii ? 2 : p.isList ? p.countBytes : p.typeBytes;

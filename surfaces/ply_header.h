@@ -10,9 +10,9 @@ namespace rtfact {
 struct PlyProperty {
     std::string name;
     bool isList = false;
-    int typeBytes = 4;       // scalar type (or list item type) size in bytes
-    int countBytes = 0;      // list count type size
-    char typeKind = 'f';     // 'i' signed, 'u' unsigned, 'f' floating point
+    int typeBytes = 4;    // scalar type (or list item type) size in bytes
+    int countBytes = 0;   // list count type size
+    char typeKind = 'f';  // 'i' signed, 'u' unsigned, 'f' floating point
     char countKind = 'u';
 };
 

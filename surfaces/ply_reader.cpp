@@ -64,8 +64,8 @@ class PlyData {
         // Binary values take their size; ASCII ones a character and a separator (but the last).
         const double fits = ascii() ? double(remaining() + 1) / 2 : double(remaining()) / p.typeBytes;
         if (c > fits)
-            throw Error(file_, "truncated or corrupt PLY data: " + where.str() + " lists " + number(c) + " values but only " +
-                                   std::to_string(remaining()) + " bytes are left");
+            throw Error(file_, "truncated or corrupt PLY data: " + where.str() + " lists " + number(c) +
+                                   " values but only " + std::to_string(remaining()) + " bytes are left");
         return uint64_t(c);
     }
     void skipList(const PlyProperty& p, uint64_t n) {
@@ -113,8 +113,10 @@ void readPolygon(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, c
     uint32_t first = 0, prev = 0;
     for (uint64_t j = 0; j < n; ++j) {
         const uint32_t id = vertexIndex(data.file(), data.value(p.typeKind, p.typeBytes), nv, where);
-        if (j == 0) first = id;
-        else if (j >= 2 && first != prev && prev != id && first != id) out.insert(out.end(), {first, prev, id});
+        if (j == 0)
+            first = id;
+        else if (j >= 2 && first != prev && prev != id && first != id)
+            out.insert(out.end(), {first, prev, id});
         prev = id;
     }
 }
@@ -135,12 +137,14 @@ void readStrip(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, con
             continue;
         }
         if (!(x >= 0 && x < double(nv)) || x != std::floor(x))
-            throw Error(data.file(), where.str() + " entry " + std::to_string(j) + " refers to vertex " + PlyData::number(x) +
-                                         " of " + std::to_string(nv) + " (only -1 ends a strip)");
+            throw Error(data.file(), where.str() + " entry " + std::to_string(j) + " refers to vertex " +
+                                         PlyData::number(x) + " of " + std::to_string(nv) + " (only -1 ends a strip)");
         const uint32_t c = uint32_t(x);
         if (run >= 2 && a != b && b != c && a != c) {
-            if (run & 1) out.insert(out.end(), {b, a, c});
-            else out.insert(out.end(), {a, b, c});
+            if (run & 1)
+                out.insert(out.end(), {b, a, c});
+            else
+                out.insert(out.end(), {a, b, c});
         }
         a = b;
         b = c;
@@ -162,20 +166,32 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
             for (int i = 0; i < int(e.props.size()); ++i) {
                 const std::string& n = e.props[size_t(i)].name;
                 if (e.props[size_t(i)].isList) continue;
-                if (n == "x") px = i;
-                else if (n == "y") py = i;
-                else if (n == "z") pz = i;
-                else if (n == "nx") nx = i;
-                else if (n == "ny") ny = i;
-                else if (n == "nz") nz = i;
-                else if (n == "red" || n == "r") cr = i;
-                else if (n == "green" || n == "g") cg = i;
-                else if (n == "blue" || n == "b") cb = i;
-                else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s") tu = i;
-                else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t") tv = i;
+                if (n == "x")
+                    px = i;
+                else if (n == "y")
+                    py = i;
+                else if (n == "z")
+                    pz = i;
+                else if (n == "nx")
+                    nx = i;
+                else if (n == "ny")
+                    ny = i;
+                else if (n == "nz")
+                    nz = i;
+                else if (n == "red" || n == "r")
+                    cr = i;
+                else if (n == "green" || n == "g")
+                    cg = i;
+                else if (n == "blue" || n == "b")
+                    cb = i;
+                else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s")
+                    tu = i;
+                else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t")
+                    tv = i;
             }
             if (px < 0 || py < 0 || pz < 0) throw Error(file, "PLY vertex element lacks x, y or z");
-            const bool hasN = nx >= 0 && ny >= 0 && nz >= 0, hasC = cr >= 0 && cg >= 0 && cb >= 0, hasT = tu >= 0 && tv >= 0;
+            const bool hasN = nx >= 0 && ny >= 0 && nz >= 0, hasC = cr >= 0 && cg >= 0 && cb >= 0,
+                       hasT = tu >= 0 && tv >= 0;
             m.positions.resize(size_t(e.count));
             if (hasN) m.normals.resize(size_t(e.count));
             if (hasC) m.colors.resize(size_t(e.count));
@@ -192,8 +208,10 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
                     v[i] = data.value(p.typeKind, p.typeBytes);
                 }
                 m.positions[k] = {float(v[size_t(px)]), float(v[size_t(py)]), float(v[size_t(pz)])};
-                if (hasN) m.normals[k] = normalize(Vec3f{float(v[size_t(nx)]), float(v[size_t(ny)]), float(v[size_t(nz)])});
-                if (hasC) m.colors[k] = Vec3f{float(v[size_t(cr)]), float(v[size_t(cg)]), float(v[size_t(cb)])} * colorScale;
+                if (hasN)
+                    m.normals[k] = normalize(Vec3f{float(v[size_t(nx)]), float(v[size_t(ny)]), float(v[size_t(nz)])});
+                if (hasC)
+                    m.colors[k] = Vec3f{float(v[size_t(cr)]), float(v[size_t(cg)]), float(v[size_t(cb)])} * colorScale;
                 if (hasT) {
                     m.uvs[2 * k] = float(v[size_t(tu)]);
                     m.uvs[2 * k + 1] = float(v[size_t(tv)]);
@@ -210,9 +228,12 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
                     }
                     const Where where{e.name, k};
                     const uint64_t c = data.listLength(p, where);
-                    if (&p != idx) data.skipList(p, c);
-                    else if (strips) readStrip(data, p, c, nv, where, m.indices);
-                    else readPolygon(data, p, c, nv, where, m.indices);
+                    if (&p != idx)
+                        data.skipList(p, c);
+                    else if (strips)
+                        readStrip(data, p, c, nv, where, m.indices);
+                    else
+                        readPolygon(data, p, c, nv, where, m.indices);
                 }
             }
         } else {

@@ -55,7 +55,8 @@ struct TriangleIntersector {
         // Lanes hit when the three edge functions agree in sign and t is in range. The
         // distance comes from the plane equation (tnum / dot(n, d)), not from the edge
         // sum: edge functions of a small triangle far from the origin lose many bits.
-        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const P& tnum, const P& nd) __attribute__((always_inline)) {
+        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const P& tnum, const P& nd)
+            __attribute__((always_inline)) {
             // A tolerance of 2^-16 of the edge magnitudes closes vertices, where several
             // near-zero spoke values of one fan may all round to the same side.
             const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
@@ -87,8 +88,8 @@ struct TriangleIntersector {
             for (int k = firstChunk; k < Packet<N>::C; ++k) {
                 const Vec3<W> o = rays.org.chunk(k), d = rays.dir.chunk(k);
                 const Vec3<W> a = v0 - o, b = v1 - o, c = v2 - o;
-                finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d), dot(nn, a),
-                       dot(nn, d));
+                finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d),
+                       dot(nn, a), dot(nn, d));
             }
         }
     }

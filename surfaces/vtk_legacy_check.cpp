@@ -162,8 +162,10 @@ VtkLegacyHeader parseHeader(Source& s) {
     std::string t;
     if (!s.token(t)) s.fail("truncated VTK header: no ASCII or BINARY line");
     const std::string fmt = lower(t);
-    if (fmt == "binary") h.binary = true;
-    else if (fmt != "ascii") s.fail("VTK header: unknown file format " + quote(t) + " (ASCII or BINARY expected)");
+    if (fmt == "binary")
+        h.binary = true;
+    else if (fmt != "ascii")
+        s.fail("VTK header: unknown file format " + quote(t) + " (ASCII or BINARY expected)");
     if (!s.token(t)) s.fail("truncated VTK header: no DATASET line");
     h.firstKeyword = upper(t);
     if (h.firstKeyword == "DATASET") {
@@ -182,14 +184,19 @@ class Walker {
         // Geometry, then attributes (VTK reads POINT_DATA / CELL_DATA to the end).
         while (s_.token(kw)) {
             const std::string k = upper(kw);
-            if (k == "POINTS") points();
-            else if (k == "VERTICES" || k == "LINES" || k == "POLYGONS" || k == "TRIANGLE_STRIPS") cells(k);
-            else if (k == "FIELD") field("FIELD");
-            else if (k == "METADATA") metadata();
+            if (k == "POINTS")
+                points();
+            else if (k == "VERTICES" || k == "LINES" || k == "POLYGONS" || k == "TRIANGLE_STRIPS")
+                cells(k);
+            else if (k == "FIELD")
+                field("FIELD");
+            else if (k == "METADATA")
+                metadata();
             else if (k == "POINT_DATA" || k == "CELL_DATA") {
                 attributes(k);
                 break;
-            } else fail("unsupported legacy VTK section " + quote(kw));
+            } else
+                fail("unsupported legacy VTK section " + quote(kw));
         }
         if (!havePoints_) fail("POLYDATA file without a POINTS section");
         if (haveIndex_ && maxIndex_ >= sum_.points)
@@ -202,7 +209,8 @@ class Walker {
 
     uint64_t mul(uint64_t a, uint64_t b, const std::string& what) const {
         uint64_t r;
-        if (__builtin_mul_overflow(a, b, &r) || r > kMaxCount) fail(what + ": value count overflows (" + str(a) + " x " + str(b) + ")");
+        if (__builtin_mul_overflow(a, b, &r) || r > kMaxCount)
+            fail(what + ": value count overflows (" + str(a) + " x " + str(b) + ")");
         return r;
     }
 
@@ -216,7 +224,8 @@ class Walker {
         if (b != e && *b == '-') fail(what + " is negative (" + quote(t) + ")");
         uint64_t v = 0;
         const auto r = std::from_chars(b, e, v);
-        if (b == e || r.ptr != e || r.ec == std::errc::invalid_argument) fail(what + ": expected a count, found " + quote(t));
+        if (b == e || r.ptr != e || r.ec == std::errc::invalid_argument)
+            fail(what + ": expected a count, found " + quote(t));
         if (r.ec == std::errc::result_out_of_range || v > max) fail(what + " is too large (" + quote(t) + ")");
         return v;
     }
@@ -232,19 +241,32 @@ class Walker {
         const std::string n = lower(t);
         ValueType v;
         v.name = n;
-        if (n == "char" || n == "signed_char") v = {n, 1, true, true};
-        else if (n == "unsigned_char") v = {n, 1, true, false};
-        else if (n == "short") v = {n, 2, true, true};
-        else if (n == "unsigned_short") v = {n, 2, true, false};
-        else if (n == "int" || n == "vtkidtype") v = {n, 4, true, true};  // vtkIdType is written as int
-        else if (n == "unsigned_int") v = {n, 4, true, false};
-        else if (n == "long" || n == "vtktypeint64") v = {n, 8, true, true};
-        else if (n == "unsigned_long" || n == "vtktypeuint64") v = {n, 8, true, false};
-        else if (n == "float") v = {n, 4, false, true};
-        else if (n == "double") v = {n, 8, false, true};
-        else if (n == "bit") fail(what + ": 'bit' arrays are not supported");
-        else if (n == "string" || n == "utf8_string" || n == "variant") fail(what + ": " + quote(t) + " arrays are not supported");
-        else fail(what + ": unknown data type " + quote(t));
+        if (n == "char" || n == "signed_char")
+            v = {n, 1, true, true};
+        else if (n == "unsigned_char")
+            v = {n, 1, true, false};
+        else if (n == "short")
+            v = {n, 2, true, true};
+        else if (n == "unsigned_short")
+            v = {n, 2, true, false};
+        else if (n == "int" || n == "vtkidtype")
+            v = {n, 4, true, true};  // vtkIdType is written as int
+        else if (n == "unsigned_int")
+            v = {n, 4, true, false};
+        else if (n == "long" || n == "vtktypeint64")
+            v = {n, 8, true, true};
+        else if (n == "unsigned_long" || n == "vtktypeuint64")
+            v = {n, 8, true, false};
+        else if (n == "float")
+            v = {n, 4, false, true};
+        else if (n == "double")
+            v = {n, 8, false, true};
+        else if (n == "bit")
+            fail(what + ": 'bit' arrays are not supported");
+        else if (n == "string" || n == "utf8_string" || n == "variant")
+            fail(what + ": " + quote(t) + " arrays are not supported");
+        else
+            fail(what + ": unknown data type " + quote(t));
         return v;
     }
 
@@ -252,15 +274,16 @@ class Walker {
     void endHeaderLine(const std::string& what) {
         int c;
         while ((c = s_.get()) != EOF && c != '\n')
-            if (c != ' ' && c != '\t' && c != '\r') fail(what + ": unexpected byte after the header line, before the binary data");
+            if (c != ' ' && c != '\t' && c != '\r')
+                fail(what + ": unexpected byte after the header line, before the binary data");
         if (c == EOF) fail("truncated file: " + what + " has no binary data after its header line");
     }
 
     void needBytes(const std::string& what, uint64_t n, const ValueType& t) {
         const uint64_t bytes = mul(n, uint64_t(t.bytes), what);
         if (bytes > s_.remaining())
-            fail("truncated or lying file: " + what + " declares " + str(n) + " values (" + str(bytes) + " bytes) but only " +
-                 str(s_.remaining()) + " bytes follow");
+            fail("truncated or lying file: " + what + " declares " + str(n) + " values (" + str(bytes) +
+                 " bytes) but only " + str(s_.remaining()) + " bytes follow");
     }
 
     bool numberToken(const std::string& t, bool integer) const {
@@ -288,7 +311,8 @@ class Walker {
             std::string tok;
             for (uint64_t i = 0; i < n; ++i) {
                 if (!s_.token(tok))
-                    fail("truncated or lying file: " + what + " declares " + str(n) + " values but the file ends after " + str(i));
+                    fail("truncated or lying file: " + what + " declares " + str(n) +
+                         " values but the file ends after " + str(i));
                 if (!numberToken(tok, t.integer))
                     fail(what + ": value " + str(i + 1) + " of " + str(n) + " is " + quote(tok) + ", not " +
                          (t.integer ? "an integer" : "a number"));
@@ -308,7 +332,8 @@ class Walker {
         }
         std::string tok;
         if (!s_.token(tok))
-            fail("truncated or lying file: " + what + " declares " + str(n) + " values but the file ends after " + str(i));
+            fail("truncated or lying file: " + what + " declares " + str(n) + " values but the file ends after " +
+                 str(i));
         const char* b = tok.data();
         const char* e = tok.data() + tok.size();
         if (b != e && *b == '+') ++b;
@@ -316,7 +341,8 @@ class Walker {
         const auto r = std::from_chars(b, e, v);
         if (b == e || r.ptr != e || r.ec == std::errc::invalid_argument)
             fail(what + ": value " + str(i + 1) + " of " + str(n) + " is " + quote(tok) + ", not an integer");
-        if (r.ec == std::errc::result_out_of_range) fail(what + ": value " + str(i + 1) + " (" + quote(tok) + ") is out of range");
+        if (r.ec == std::errc::result_out_of_range)
+            fail(what + ": value " + str(i + 1) + " (" + quote(tok) + ") is out of range");
         if (t.bytes == 4 && (v < std::numeric_limits<int32_t>::min() || v > std::numeric_limits<int32_t>::max()))
             fail(what + ": value " + str(i + 1) + " (" + quote(tok) + ") does not fit a 32-bit int");
         return v;
@@ -326,14 +352,15 @@ class Walker {
     void pointIndex(const std::string& what, const char* unit, uint64_t n, int64_t idx) {
         if (idx < 0) fail(what + ": " + unit + " " + str(n) + " refers to point " + std::to_string(idx));
         if (havePoints_ && uint64_t(idx) >= sum_.points)
-            fail(what + ": " + unit + " " + str(n) + " refers to point " + std::to_string(idx) + " but POINTS declares " +
-                 str(sum_.points));
+            fail(what + ": " + unit + " " + str(n) + " refers to point " + std::to_string(idx) +
+                 " but POINTS declares " + str(sum_.points));
         maxIndex_ = std::max(maxIndex_, uint64_t(idx));
         haveIndex_ = true;
     }
 
     void addCells(uint64_t n, const std::string& what) {
-        if (__builtin_add_overflow(sum_.cells, n, &sum_.cells) || sum_.cells > kMaxCount) fail(what + ": cell count overflows");
+        if (__builtin_add_overflow(sum_.cells, n, &sum_.cells) || sum_.cells > kMaxCount)
+            fail(what + ": cell count overflows");
     }
 
     // After an array VTK pops blank lines and an optional METADATA block.
@@ -348,7 +375,8 @@ class Walker {
     void metadata() {
         std::string l;
         s_.line(l, 0);  // rest of the METADATA line
-        while (s_.line(l, 1) && !l.empty()) {}
+        while (s_.line(l, 1) && !l.empty()) {
+        }
     }
 
     void points() {
@@ -357,7 +385,8 @@ class Walker {
         const ValueType t = type("POINTS");
         sum_.points = n;
         havePoints_ = true;
-        if (haveIndex_ && maxIndex_ >= n) fail("cells refer to point " + str(maxIndex_) + " but POINTS declares " + str(n));
+        if (haveIndex_ && maxIndex_ >= n)
+            fail("cells refer to point " + str(maxIndex_) + " but POINTS declares " + str(n));
         values("POINTS", mul(n, 3, "POINTS"), t);
     }
 
@@ -378,8 +407,8 @@ class Walker {
             const int64_t pts = integer(k, i++, size, t);
             if (pts < 0) fail(k + ": cell " + str(cell) + " has a negative point count (" + std::to_string(pts) + ")");
             if (uint64_t(pts) > size - i)
-                fail(k + ": cell " + str(cell) + " declares " + std::to_string(pts) + " points but only " + str(size - i) +
-                     " of the " + str(size) + " declared values remain");
+                fail(k + ": cell " + str(cell) + " declares " + std::to_string(pts) + " points but only " +
+                     str(size - i) + " of the " + str(size) + " declared values remain");
             for (int64_t j = 0; j < pts; ++j) pointIndex(k, "cell", cell, integer(k, i++, size, t));
             ++cell;
         }
@@ -406,12 +435,15 @@ class Walker {
         for (uint64_t i = 0; i < nOff; ++i) {
             const int64_t o = integer(wo, i, nOff, to);
             if (i == 0 && o != 0) fail(wo + ": the first offset is " + std::to_string(o) + ", not 0");
-            if (o < prev) fail(wo + ": offset " + str(i) + " (" + std::to_string(o) + ") is smaller than the one before");
+            if (o < prev)
+                fail(wo + ": offset " + str(i) + " (" + std::to_string(o) + ") is smaller than the one before");
             if (uint64_t(o) > nConn)
-                fail(wo + ": offset " + str(i) + " (" + std::to_string(o) + ") is past the connectivity size " + str(nConn));
+                fail(wo + ": offset " + str(i) + " (" + std::to_string(o) + ") is past the connectivity size " +
+                     str(nConn));
             prev = o;
         }
-        if (uint64_t(prev) != nConn) fail(wo + ": the last offset is " + std::to_string(prev) + ", not the connectivity size " + str(nConn));
+        if (uint64_t(prev) != nConn)
+            fail(wo + ": the last offset is " + std::to_string(prev) + ", not the connectivity size " + str(nConn));
         arrayTail();
         t = word(k + " CONNECTIVITY");
         if (upper(t) != "CONNECTIVITY") fail(k + ": expected CONNECTIVITY, found " + quote(t));
@@ -454,7 +486,8 @@ class Walker {
             const uint64_t n = count(k + " count");
             const uint64_t expect = pointData ? sum_.points : sum_.cells;
             if (n != expect)
-                fail(k + " declares " + str(n) + " values but the file has " + str(expect) + (pointData ? " points" : " cells"));
+                fail(k + " declares " + str(n) + " values but the file has " + str(expect) +
+                     (pointData ? " points" : " cells"));
             for (;;) {
                 if (!s_.token(kw)) return;
                 const std::string a = upper(kw);
@@ -483,16 +516,21 @@ class Walker {
                     const std::string what = where + " " + quote(word(where + " name"));
                     const uint64_t nc = count(what + " component count", kInt);
                     if (nc == 0) fail(what + ": zero components");
-                    values(what, mul(n, nc, what), binary_ ? ValueType{"unsigned_char", 1, true, false} : ValueType{"float", 4, false, true});
+                    values(what, mul(n, nc, what),
+                           binary_ ? ValueType{"unsigned_char", 1, true, false} : ValueType{"float", 4, false, true});
                 } else if (a == "LOOKUP_TABLE") {
                     const std::string what = where + " " + quote(word(where + " name"));
                     const uint64_t size = count(what + " size", kInt);
-                    values(what, mul(size, 4, what), binary_ ? ValueType{"unsigned_char", 1, true, false} : ValueType{"float", 4, false, true});
+                    values(what, mul(size, 4, what),
+                           binary_ ? ValueType{"unsigned_char", 1, true, false} : ValueType{"float", 4, false, true});
                 } else if (a == "VECTORS" || a == "NORMALS" || a == "TENSORS" || a == "TENSORS6" || a == "GLOBAL_IDS" ||
                            a == "PEDIGREE_IDS" || (a == "EDGE_FLAGS" && pointData)) {
                     const std::string what = where + " " + quote(word(where + " name"));
                     const ValueType t = type(what);
-                    const uint64_t per = a == "VECTORS" || a == "NORMALS" ? 3 : a == "TENSORS" ? 9 : a == "TENSORS6" ? 6 : 1;
+                    const uint64_t per = a == "VECTORS" || a == "NORMALS" ? 3
+                                         : a == "TENSORS"                 ? 9
+                                         : a == "TENSORS6"                ? 6
+                                                                          : 1;
                     values(what, mul(n, per, what), t);
                 } else if (a == "TEXTURE_COORDINATES") {
                     const std::string what = where + " " + quote(word(where + " name"));
@@ -504,7 +542,8 @@ class Walker {
                     field(where);
                 } else if (a == "METADATA") {
                     metadata();
-                } else if (a == "POINTS" || a == "VERTICES" || a == "LINES" || a == "POLYGONS" || a == "TRIANGLE_STRIPS") {
+                } else if (a == "POINTS" || a == "VERTICES" || a == "LINES" || a == "POLYGONS" ||
+                           a == "TRIANGLE_STRIPS") {
                     fail(a + " section after " + k + " (VTK reads no geometry after the attribute data)");
                 } else {
                     fail("unsupported legacy VTK section " + quote(kw) + " in " + k);
@@ -533,7 +572,8 @@ VtkLegacySummary validateVtkLegacyPolyData(const std::string& file) {
     Source s(file);
     const VtkLegacyHeader h = parseHeader(s);
     if (!h.vtk) s.fail("not a VTK legacy file (missing '# vtk DataFile Version' line)");
-    if (h.dataset != "POLYDATA") s.fail("VTK legacy file is not POLYDATA (" + quote(h.firstKeyword + " " + h.dataset) + ")");
+    if (h.dataset != "POLYDATA")
+        s.fail("VTK legacy file is not POLYDATA (" + quote(h.firstKeyword + " " + h.dataset) + ")");
     return Walker(s, h).run();
 }
 

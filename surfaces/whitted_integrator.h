@@ -28,7 +28,8 @@ struct WhittedIntegrator {
 
    private:
     template <int N, class Scene>
-    Vec3<N> trace(const Scene& scene, const RayPacket<N>& rays, const Mask<N>& active, int depth, Packet<N>* firstT) const {
+    Vec3<N> trace(const Scene& scene, const RayPacket<N>& rays, const Mask<N>& active, int depth,
+                  Packet<N>* firstT) const {
         using P = Packet<N>;
         const P zero(0.0f);
         const auto hit = scene.template intersect<N>(rays, active);
@@ -44,7 +45,8 @@ struct WhittedIntegrator {
         static const PathMaterial kDefault{};
         BitMask<N>(found).forEach([&](int i) {
             const int32_t mid = sp.material[i];
-            const PathMaterial& m = materials.empty() || mid < 0 || size_t(mid) >= materials.size() ? kDefault : materials[size_t(mid)];
+            const PathMaterial& m =
+                materials.empty() || mid < 0 || size_t(mid) >= materials.size() ? kDefault : materials[size_t(mid)];
             const Vec3f d = rays.dir.lane(i), n = sp.n.lane(i);
             const float cosi = -dot(d, n);
             if (m.kind == PathMaterial::Lambert) {

@@ -12,13 +12,17 @@
 namespace rtfact::volume {
 
 float BrickedVolume::stored(int i, int j, int k) const {
-    const int bx = std::min(i / kCells, nb[0] - 1), by = std::min(j / kCells, nb[1] - 1), bz = std::min(k / kCells, nb[2] - 1);
-    const size_t n = size_t(brickStart[brickIndex(bx, by, bz)]) + size_t(i - bx * kCells) + size_t(j - by * kCells) * kEdge +
-                     size_t(k - bz * kCells) * kEdge * kEdge;
+    const int bx = std::min(i / kCells, nb[0] - 1), by = std::min(j / kCells, nb[1] - 1),
+              bz = std::min(k / kCells, nb[2] - 1);
+    const size_t n = size_t(brickStart[brickIndex(bx, by, bz)]) + size_t(i - bx * kCells) +
+                     size_t(j - by * kCells) * kEdge + size_t(k - bz * kCells) * kEdge * kEdge;
     switch (storage) {
-        case Storage::U8: return float(pool[n]);
-        case Storage::U16: return float(data<uint16_t>()[n]);
-        default: return data<float>()[n];
+        case Storage::U8:
+            return float(pool[n]);
+        case Storage::U16:
+            return float(data<uint16_t>()[n]);
+        default:
+            return data<float>()[n];
     }
 }
 
@@ -65,7 +69,8 @@ void brickDense(VolumeGrid& g, BrickedVolume& v, bool release) {
     // Pass 1: which bricks are all zero (share brick 0) and where the others go.
     std::vector<uint8_t> zero(nb, 0);
     tbb::parallel_for(size_t(0), nb, [&](size_t b) {
-        const int bx = int(b % size_t(v.nb[0])), by = int((b / size_t(v.nb[0])) % size_t(v.nb[1])), bz = int(b / (size_t(v.nb[0]) * size_t(v.nb[1])));
+        const int bx = int(b % size_t(v.nb[0])), by = int((b / size_t(v.nb[0])) % size_t(v.nb[1])),
+                  bz = int(b / (size_t(v.nb[0]) * size_t(v.nb[1])));
         bool allZero = true;
         for (int k = 0; k < BrickedVolume::kEdge && allZero; ++k) {
             const int z = std::min(bz * BrickedVolume::kCells + k, g.dims[2] - 1);
@@ -88,7 +93,8 @@ void brickDense(VolumeGrid& g, BrickedVolume& v, bool release) {
             start[b] = next;
             next += BrickedVolume::kBrick;
         }
-    if (next > int64_t(std::numeric_limits<int32_t>::max()) - 64) throw Error("", "volume too large for 32-bit brick offsets");
+    if (next > int64_t(std::numeric_limits<int32_t>::max()) - 64)
+        throw Error("", "volume too large for 32-bit brick offsets");
     v.pool.assign(size_t(next) * sizeof(T) + 64, 0);
     T* pool = reinterpret_cast<T*>(v.pool.data());
     // Pass 2 by z-slabs of bricks, so the dense slab can be released behind us.
@@ -133,9 +139,15 @@ BrickedVolume brickVolume(VolumeGrid& g, bool release) {
     v.sourceType = g.sourceType;
     v.meta = g.meta;
     switch (g.storage) {
-        case Storage::U8: brickDense<uint8_t>(g, v, release); break;
-        case Storage::U16: brickDense<uint16_t>(g, v, release); break;
-        default: brickDense<float>(g, v, release); break;
+        case Storage::U8:
+            brickDense<uint8_t>(g, v, release);
+            break;
+        case Storage::U16:
+            brickDense<uint16_t>(g, v, release);
+            break;
+        default:
+            brickDense<float>(g, v, release);
+            break;
     }
     if (release) {
         g.bytes.clear();

@@ -29,12 +29,14 @@ struct BrickedVolume {
     float scale = 1.0f, offset = 0.0f;
     std::string sourceType;
     VolumeMetadata meta;
-    std::vector<uint8_t> pool;            // bricks of kBrick samples; brick 0 is all zero
-    std::vector<int32_t> brickStart;      // per brick: first sample in the pool
-    std::vector<float> cellLo, cellHi;    // per brick: stored min/max
+    std::vector<uint8_t> pool;          // bricks of kBrick samples; brick 0 is all zero
+    std::vector<int32_t> brickStart;    // per brick: first sample in the pool
+    std::vector<float> cellLo, cellHi;  // per brick: stored min/max
 
     size_t brickCount() const { return size_t(nb[0]) * size_t(nb[1]) * size_t(nb[2]); }
-    size_t brickIndex(int bx, int by, int bz) const { return (size_t(bz) * size_t(nb[1]) + size_t(by)) * size_t(nb[0]) + size_t(bx); }
+    size_t brickIndex(int bx, int by, int bz) const {
+        return (size_t(bz) * size_t(nb[1]) + size_t(by)) * size_t(nb[0]) + size_t(bx);
+    }
     size_t voxelCount() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
     // non-empty bricks (brick 0, the shared zero brick, not counted)
     size_t storedBricks() const { return pool.size() / (size_t(kBrick) * size_t(storageBytes(storage))) - 1; }
@@ -42,7 +44,9 @@ struct BrickedVolume {
         return pool.capacity() + brickStart.capacity() * 4 + (cellLo.capacity() + cellHi.capacity()) * 4;
     }
     template <class T>
-    const T* data() const { return reinterpret_cast<const T*>(pool.data()); }
+    const T* data() const {
+        return reinterpret_cast<const T*>(pool.data());
+    }
     AABB bounds() const {
         const Vec3f ext((dims[0] - 1) * spacing.x, (dims[1] - 1) * spacing.y, (dims[2] - 1) * spacing.z);
         return {origin, origin + ext};
@@ -80,12 +84,16 @@ void BrickBuilder::addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill) 
     for (int k = 0; k < BrickedVolume::kEdge; ++k)
         for (int j = 0; j < BrickedVolume::kEdge; ++j)
             for (int i = 0; i < BrickedVolume::kEdge; ++i, ++n) {
-                const float s = fill(bx * BrickedVolume::kCells + i, by * BrickedVolume::kCells + j, bz * BrickedVolume::kCells + k);
+                const float s = fill(bx * BrickedVolume::kCells + i, by * BrickedVolume::kCells + j,
+                                     bz * BrickedVolume::kCells + k);
                 lo = std::min(lo, s);
                 hi = std::max(hi, s);
-                if (v.storage == Storage::U8) dst[n] = uint8_t(s);
-                else if (v.storage == Storage::U16) reinterpret_cast<uint16_t*>(dst)[n] = uint16_t(s);
-                else reinterpret_cast<float*>(dst)[n] = s;
+                if (v.storage == Storage::U8)
+                    dst[n] = uint8_t(s);
+                else if (v.storage == Storage::U16)
+                    reinterpret_cast<uint16_t*>(dst)[n] = uint16_t(s);
+                else
+                    reinterpret_cast<float*>(dst)[n] = s;
             }
     const size_t b = v.brickIndex(bx, by, bz);
     v.brickStart[b] = int32_t(start / size_t(storageBytes(v.storage)));

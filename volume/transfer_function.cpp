@@ -1,10 +1,9 @@
 #include "volume/transfer_function.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/util/error.h"
@@ -46,24 +45,33 @@ std::vector<OpacityPoint> ramp(float lo = 0.1f, float hi = 0.6f) { return {{0.0f
 
 }  // namespace
 
-Vec3f TransferFunction::color(float x) const { return interpolate(colors, x, [](const ColorPoint& p) { return p.rgb; }); }
-float TransferFunction::alpha(float x) const { return interpolate(opacity, x, [](const OpacityPoint& p) { return p.a; }); }
+Vec3f TransferFunction::color(float x) const {
+    return interpolate(colors, x, [](const ColorPoint& p) { return p.rgb; });
+}
+float TransferFunction::alpha(float x) const {
+    return interpolate(opacity, x, [](const OpacityPoint& p) { return p.a; });
+}
 
 void TransferFunction::validate(const std::string& source) const {
     if (colors.empty()) throw Error(source, "transfer function has no colour points");
     if (opacity.empty()) throw Error(source, "transfer function has no opacity points");
     for (size_t i = 0; i < colors.size(); ++i) {
         const auto& p = colors[i];
-        if (!std::isfinite(p.x) || !isFinite(p.rgb)) throw Error(source, "transfer function colour point " + std::to_string(i) + " is not finite");
+        if (!std::isfinite(p.x) || !isFinite(p.rgb))
+            throw Error(source, "transfer function colour point " + std::to_string(i) + " is not finite");
         if (i && p.x < colors[i - 1].x) throw Error(source, "transfer function colour points are not sorted by value");
         for (int c = 0; c < 3; ++c)
-            if (p.rgb[c] < 0 || p.rgb[c] > 1) throw Error(source, "transfer function colour point " + std::to_string(i) + " is outside [0, 1]");
+            if (p.rgb[c] < 0 || p.rgb[c] > 1)
+                throw Error(source, "transfer function colour point " + std::to_string(i) + " is outside [0, 1]");
     }
     for (size_t i = 0; i < opacity.size(); ++i) {
         const auto& p = opacity[i];
-        if (!std::isfinite(p.x) || !std::isfinite(p.a)) throw Error(source, "transfer function opacity point " + std::to_string(i) + " is not finite");
-        if (i && p.x < opacity[i - 1].x) throw Error(source, "transfer function opacity points are not sorted by value");
-        if (p.a < 0 || p.a > 1) throw Error(source, "transfer function opacity point " + std::to_string(i) + " is outside [0, 1]");
+        if (!std::isfinite(p.x) || !std::isfinite(p.a))
+            throw Error(source, "transfer function opacity point " + std::to_string(i) + " is not finite");
+        if (i && p.x < opacity[i - 1].x)
+            throw Error(source, "transfer function opacity points are not sorted by value");
+        if (p.a < 0 || p.a > 1)
+            throw Error(source, "transfer function opacity point " + std::to_string(i) + " is outside [0, 1]");
     }
 }
 
@@ -77,33 +85,53 @@ TransferFunction transferFunctionPreset(const std::string& name) {
     auto H = [](float h) { return (h + 1000.0f) / 3000.0f; };
     if (name == "ct-bone")
         return make("ct-bone",
-                    {{H(150), {0.55f, 0.25f, 0.15f}}, {H(300), {0.88f, 0.76f, 0.6f}}, {H(700), {1.0f, 0.97f, 0.9f}}, {1.0f, {1, 1, 1}}},
+                    {{H(150), {0.55f, 0.25f, 0.15f}},
+                     {H(300), {0.88f, 0.76f, 0.6f}},
+                     {H(700), {1.0f, 0.97f, 0.9f}},
+                     {1.0f, {1, 1, 1}}},
                     {{0.0f, 0.0f}, {H(150), 0.0f}, {H(350), 0.35f}, {H(900), 0.8f}, {1.0f, 0.9f}}, hu);
     if (name == "ct-skin")
         return make("ct-skin",
-                    {{H(-600), {0.7f, 0.45f, 0.35f}}, {H(-200), {0.95f, 0.75f, 0.62f}}, {H(200), {0.98f, 0.9f, 0.8f}}, {1.0f, {1, 1, 1}}},
-                    {{0.0f, 0.0f}, {H(-600), 0.0f}, {H(-400), 0.08f}, {H(100), 0.12f}, {H(300), 0.6f}, {1.0f, 0.85f}}, hu);
+                    {{H(-600), {0.7f, 0.45f, 0.35f}},
+                     {H(-200), {0.95f, 0.75f, 0.62f}},
+                     {H(200), {0.98f, 0.9f, 0.8f}},
+                     {1.0f, {1, 1, 1}}},
+                    {{0.0f, 0.0f}, {H(-600), 0.0f}, {H(-400), 0.08f}, {H(100), 0.12f}, {H(300), 0.6f}, {1.0f, 0.85f}},
+                    hu);
     if (name == "ct-muscle")
         return make("ct-muscle",
-                    {{H(-100), {0.55f, 0.15f, 0.1f}}, {H(40), {0.8f, 0.25f, 0.2f}}, {H(250), {0.95f, 0.85f, 0.75f}}, {1.0f, {1, 1, 1}}},
+                    {{H(-100), {0.55f, 0.15f, 0.1f}},
+                     {H(40), {0.8f, 0.25f, 0.2f}},
+                     {H(250), {0.95f, 0.85f, 0.75f}},
+                     {1.0f, {1, 1, 1}}},
                     {{0.0f, 0.0f}, {H(-50), 0.0f}, {H(40), 0.12f}, {H(150), 0.05f}, {H(300), 0.5f}, {1.0f, 0.85f}}, hu);
     if (name == "mr-default")
-        return make("mr-default", {{0.0f, {0.0f, 0.0f, 0.0f}}, {0.3f, {0.55f, 0.45f, 0.4f}}, {0.7f, {0.9f, 0.85f, 0.8f}}, {1.0f, {1, 1, 1}}},
-                    {{0.0f, 0.0f}, {0.15f, 0.0f}, {0.4f, 0.06f}, {0.7f, 0.25f}, {1.0f, 0.6f}});
+        return make(
+            "mr-default",
+            {{0.0f, {0.0f, 0.0f, 0.0f}}, {0.3f, {0.55f, 0.45f, 0.4f}}, {0.7f, {0.9f, 0.85f, 0.8f}}, {1.0f, {1, 1, 1}}},
+            {{0.0f, 0.0f}, {0.15f, 0.0f}, {0.4f, 0.06f}, {0.7f, 0.25f}, {1.0f, 0.6f}});
     if (name == "grayscale") return make("grayscale", {{0.0f, {0, 0, 0}}, {1.0f, {1, 1, 1}}}, ramp(0.05f, 0.5f));
     if (name == "viridis")
         return make("viridis",
-                    {{0.0f, {0.267f, 0.005f, 0.329f}}, {0.25f, {0.229f, 0.322f, 0.546f}}, {0.5f, {0.128f, 0.567f, 0.551f}},
-                     {0.75f, {0.369f, 0.789f, 0.383f}}, {1.0f, {0.993f, 0.906f, 0.144f}}},
+                    {{0.0f, {0.267f, 0.005f, 0.329f}},
+                     {0.25f, {0.229f, 0.322f, 0.546f}},
+                     {0.5f, {0.128f, 0.567f, 0.551f}},
+                     {0.75f, {0.369f, 0.789f, 0.383f}},
+                     {1.0f, {0.993f, 0.906f, 0.144f}}},
                     ramp());
     if (name == "inferno")
         return make("inferno",
-                    {{0.0f, {0.001f, 0.0f, 0.014f}}, {0.25f, {0.341f, 0.062f, 0.429f}}, {0.5f, {0.735f, 0.216f, 0.330f}},
-                     {0.75f, {0.978f, 0.557f, 0.035f}}, {1.0f, {0.988f, 0.998f, 0.645f}}},
+                    {{0.0f, {0.001f, 0.0f, 0.014f}},
+                     {0.25f, {0.341f, 0.062f, 0.429f}},
+                     {0.5f, {0.735f, 0.216f, 0.330f}},
+                     {0.75f, {0.978f, 0.557f, 0.035f}},
+                     {1.0f, {0.988f, 0.998f, 0.645f}}},
                     ramp());
     if (name == "cool-warm")
-        return make("cool-warm", {{0.0f, {0.230f, 0.299f, 0.754f}}, {0.5f, {0.865f, 0.865f, 0.865f}}, {1.0f, {0.706f, 0.016f, 0.150f}}},
-                    ramp());
+        return make(
+            "cool-warm",
+            {{0.0f, {0.230f, 0.299f, 0.754f}}, {0.5f, {0.865f, 0.865f, 0.865f}}, {1.0f, {0.706f, 0.016f, 0.150f}}},
+            ramp());
     std::string list;
     for (auto& p : transferFunctionPresets()) list += (list.empty() ? "" : ", ") + p;
     throw Error("--tf", "unknown transfer function '" + name + "' (presets: " + list + ", or a .json file)");
@@ -133,18 +161,24 @@ TransferFunction parseTransferFunctionJson(const std::string& text, const std::s
             // rescaled to [0, 1] like ParaView rescales presets to the data range.
             tf.name = j.value("Name", std::string("paraview"));
             const json& rp = j["RGBPoints"];
-            if (!rp.is_array() || rp.size() < 8 || rp.size() % 4 != 0) throw Error(source, "RGBPoints must hold groups of 4 numbers (x r g b), at least 2");
+            if (!rp.is_array() || rp.size() < 8 || rp.size() % 4 != 0)
+                throw Error(source, "RGBPoints must hold groups of 4 numbers (x r g b), at least 2");
             for (size_t i = 0; i < rp.size(); i += 4)
-                tf.colors.push_back({num(rp[i], "RGBPoints"), {num(rp[i + 1], "RGBPoints"), num(rp[i + 2], "RGBPoints"), num(rp[i + 3], "RGBPoints")}});
+                tf.colors.push_back(
+                    {num(rp[i], "RGBPoints"),
+                     {num(rp[i + 1], "RGBPoints"), num(rp[i + 2], "RGBPoints"), num(rp[i + 3], "RGBPoints")}});
             if (j.contains("Points")) {
                 const json& op = j["Points"];
-                if (!op.is_array() || op.size() < 8 || op.size() % 4 != 0) throw Error(source, "Points must hold groups of 4 numbers (x a mid sharp), at least 2");
-                for (size_t i = 0; i < op.size(); i += 4) tf.opacity.push_back({num(op[i], "Points"), num(op[i + 1], "Points")});
+                if (!op.is_array() || op.size() < 8 || op.size() % 4 != 0)
+                    throw Error(source, "Points must hold groups of 4 numbers (x a mid sharp), at least 2");
+                for (size_t i = 0; i < op.size(); i += 4)
+                    tf.opacity.push_back({num(op[i], "Points"), num(op[i + 1], "Points")});
             }
             float lo = tf.colors.front().x, hi = tf.colors.back().x;
             if (!(hi > lo)) throw Error(source, "RGBPoints span an empty range");
             for (auto& p : tf.colors) p.x = (p.x - lo) / (hi - lo);
-            if (tf.opacity.empty()) tf.opacity = ramp();
+            if (tf.opacity.empty())
+                tf.opacity = ramp();
             else {
                 const float olo = tf.opacity.front().x, ohi = tf.opacity.back().x;
                 for (auto& p : tf.opacity) p.x = ohi > olo ? (p.x - olo) / (ohi - olo) : 0.0f;
@@ -154,13 +188,17 @@ TransferFunction parseTransferFunctionJson(const std::string& text, const std::s
             // Ours: {"name", "space": "normalized"|"data", "colors": [[x,r,g,b]...], "opacity": [[x,a]...]}
             tf.name = j.value("name", std::string("custom"));
             const std::string space = j.value("space", std::string("normalized"));
-            if (space != "normalized" && space != "data") throw Error(source, "\"space\" must be \"normalized\" or \"data\"");
+            if (space != "normalized" && space != "data")
+                throw Error(source, "\"space\" must be \"normalized\" or \"data\"");
             tf.normalized = space == "normalized";
-            if (!j.contains("colors") || !j["colors"].is_array()) throw Error(source, "missing \"colors\" array ([[x, r, g, b], ...])");
-            if (!j.contains("opacity") || !j["opacity"].is_array()) throw Error(source, "missing \"opacity\" array ([[x, a], ...])");
+            if (!j.contains("colors") || !j["colors"].is_array())
+                throw Error(source, "missing \"colors\" array ([[x, r, g, b], ...])");
+            if (!j.contains("opacity") || !j["opacity"].is_array())
+                throw Error(source, "missing \"opacity\" array ([[x, a], ...])");
             for (const json& p : j["colors"]) {
                 if (!p.is_array() || p.size() != 4) throw Error(source, "each colour point must be [x, r, g, b]");
-                tf.colors.push_back({num(p[0], "colors"), {num(p[1], "colors"), num(p[2], "colors"), num(p[3], "colors")}});
+                tf.colors.push_back(
+                    {num(p[0], "colors"), {num(p[1], "colors"), num(p[2], "colors"), num(p[3], "colors")}});
             }
             for (const json& p : j["opacity"]) {
                 if (!p.is_array() || p.size() != 2) throw Error(source, "each opacity point must be [x, a]");
@@ -192,8 +230,8 @@ TransferFunction resolveTransferFunction(const std::string& s) {
     return transferFunctionPreset(s);
 }
 
-std::pair<float, float> resolveWindow(const TransferFunction& tf, float dataLo, float dataHi, std::optional<float> window,
-                                      std::optional<float> level) {
+std::pair<float, float> resolveWindow(const TransferFunction& tf, float dataLo, float dataHi,
+                                      std::optional<float> window, std::optional<float> level) {
     if (!tf.normalized) return {0.0f, 1.0f};  // points already in data units
     if (window || level) {
         const float w = window ? *window : dataHi - dataLo;
@@ -223,7 +261,8 @@ TFTable buildTable(const TransferFunction& tf, std::pair<float, float> window, f
     t.size = std::max(size, 2);
     // Points in data units: the table spans their range.
     if (!tf.normalized) {
-        window = {std::min(tf.colors.front().x, tf.opacity.front().x), std::max(tf.colors.back().x, tf.opacity.back().x)};
+        window = {std::min(tf.colors.front().x, tf.opacity.front().x),
+                  std::max(tf.colors.back().x, tf.opacity.back().x)};
         if (!(window.second > window.first)) window.second = window.first + 1.0f;
     }
     t.lo = window.first;

@@ -29,8 +29,8 @@ struct TransferFunction {
     // Window of normalized points when the data are in Hounsfield units (CT presets).
     std::optional<std::pair<float, float>> huWindow;
 
-    Vec3f color(float x) const;   // sRGB
-    float alpha(float x) const;   // opacity per voxel of distance
+    Vec3f color(float x) const;  // sRGB
+    float alpha(float x) const;  // opacity per voxel of distance
     // Throws rtfact::Error(source, ...) when points are missing, unsorted or out of range.
     void validate(const std::string& source) const;
 };
@@ -55,7 +55,7 @@ struct TFTable {
     float lo = 0, hi = 1;
     int size = 0;
     std::vector<float> r, g, b, a;
-    std::vector<float> rgba;  // the same, interleaved: r g b a per entry (for 64-bit gathers)
+    std::vector<float> rgba;             // the same, interleaved: r g b a per entry (for 64-bit gathers)
     std::vector<int32_t> visiblePrefix;  // count of entries with a > 0 in [0, i)
     // Index of data value v (nearest entry, clamped).
     int index(float v) const;

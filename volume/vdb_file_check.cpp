@@ -104,10 +104,10 @@ class Reader {
 
 // Metadata types whose value OpenVDB reads with a fixed size, whatever size the file states.
 int fixedMetaSize(const std::string& t) {
-    static const std::pair<const char*, int> k[] = {
-        {"bool", 1},   {"float", 4},  {"double", 8}, {"int32", 4},  {"int64", 8},  {"vec2i", 8},
-        {"vec2s", 8},  {"vec2d", 16}, {"vec3i", 12}, {"vec3s", 12}, {"vec3d", 24}, {"vec4i", 16},
-        {"vec4s", 16}, {"vec4d", 32}, {"mat4s", 64}, {"mat4d", 128}};
+    static const std::pair<const char*, int> k[] = {{"bool", 1},   {"float", 4},  {"double", 8}, {"int32", 4},
+                                                    {"int64", 8},  {"vec2i", 8},  {"vec2s", 8},  {"vec2d", 16},
+                                                    {"vec3i", 12}, {"vec3s", 12}, {"vec3d", 24}, {"vec4i", 16},
+                                                    {"vec4s", 16}, {"vec4d", 32}, {"mat4s", 64}, {"mat4d", 128}};
     for (const auto& [n, s] : k)
         if (t == n) return s;
     return -1;
@@ -131,18 +131,21 @@ void checkMetaMap(Reader& r, const char* what) {
             // when 0), uint32 size + compressed sizes (count int64 when 0, none when 0xffffffff).
             const uint64_t end = r.pos() + n;
             const uint32_t leaves = r.get<uint32_t>("delayed-load metadata");
-            if (uint64_t(leaves) * 64 > r.size()) r.fail("delayed-load metadata declares " + std::to_string(leaves) + " leaves");
+            if (uint64_t(leaves) * 64 > r.size())
+                r.fail("delayed-load metadata declares " + std::to_string(leaves) + " leaves");
             uint64_t used = 12;
             const uint32_t maskBytes = r.get<uint32_t>("delayed-load metadata");
             const uint64_t m = maskBytes > 0 ? maskBytes : leaves;
-            if (maskBytes > 0 && maskBytes < 16) r.fail("delayed-load metadata holds a " + std::to_string(maskBytes) + "-byte blosc chunk");
+            if (maskBytes > 0 && maskBytes < 16)
+                r.fail("delayed-load metadata holds a " + std::to_string(maskBytes) + "-byte blosc chunk");
             used += m;
             if (used > n) r.fail("delayed-load metadata overruns its " + std::to_string(n) + " bytes");
             r.skip(m, "delayed-load metadata");
             const uint32_t sizeBytes = r.get<uint32_t>("delayed-load metadata");
             if (sizeBytes != 0xffffffffu) {
                 const uint64_t c = sizeBytes > 0 ? sizeBytes : uint64_t(leaves) * 8;
-                if (sizeBytes > 0 && sizeBytes < 16) r.fail("delayed-load metadata holds a " + std::to_string(sizeBytes) + "-byte blosc chunk");
+                if (sizeBytes > 0 && sizeBytes < 16)
+                    r.fail("delayed-load metadata holds a " + std::to_string(sizeBytes) + "-byte blosc chunk");
                 used += c;
                 if (used > n) r.fail("delayed-load metadata overruns its " + std::to_string(n) + " bytes");
             }
@@ -156,20 +159,25 @@ void checkMetaMap(Reader& r, const char* what) {
 // Transform::read (format >= 219): map type name, then the map's values.
 void checkMap(Reader& r, int depth) {
     const std::string type = r.str("transform map type", 256);
-    if (type == "AffineMap" || type == "UnitaryMap") r.skip(128, "transform matrix");
-    else if (type == "ScaleMap" || type == "UniformScaleMap") r.skip(5 * 24, "transform scale");
-    else if (type == "ScaleTranslateMap" || type == "UniformScaleTranslateMap") r.skip(6 * 24, "transform scale");
-    else if (type == "TranslationMap") r.skip(24, "transform translation");
+    if (type == "AffineMap" || type == "UnitaryMap")
+        r.skip(128, "transform matrix");
+    else if (type == "ScaleMap" || type == "UniformScaleMap")
+        r.skip(5 * 24, "transform scale");
+    else if (type == "ScaleTranslateMap" || type == "UniformScaleTranslateMap")
+        r.skip(6 * 24, "transform scale");
+    else if (type == "TranslationMap")
+        r.skip(24, "transform translation");
     else if (type == "NonlinearFrustumMap" && depth == 0) {
         r.skip(48 + 16, "frustum transform");
         checkMap(r, 1);
-    } else r.fail("unknown transform map type '" + type.substr(0, 64) + "'");
+    } else
+        r.fail("unknown transform map type '" + type.substr(0, 64) + "'");
 }
 
 struct TreeSpec {
-    int valueSize = 0;     // bytes of a value (background, tiles, inactive values)
-    int dataSize = 0;      // bytes of a value in a node's value array (2 when saved as half)
-    std::vector<int> log2; // internal node levels from the root's children down, then the leaf
+    int valueSize = 0;      // bytes of a value (background, tiles, inactive values)
+    int dataSize = 0;       // bytes of a value in a node's value array (2 when saved as half)
+    std::vector<int> log2;  // internal node levels from the root's children down, then the leaf
 };
 
 // "Tree_float_5_4_3" (float and double trees only; other trees are not read by our loaders).
@@ -219,7 +227,8 @@ class TreeWalk {
             std::array<int32_t, 3> c;
             r_.read(c.data(), 12, what);
             for (int32_t v : c)
-                if (int64_t(v) % dim != 0) r_.fail(std::string(what) + " is not aligned to the root's " + std::to_string(dim) + "-voxel grid");
+                if (int64_t(v) % dim != 0)
+                    r_.fail(std::string(what) + " is not aligned to the root's " + std::to_string(dim) + "-voxel grid");
             if (!keys.insert(c).second) r_.fail(std::string("duplicate ") + what);
             return c;
         };
@@ -314,7 +323,8 @@ void checkVdbFile(const std::string& path) {
     requireRegularFile(path);  // a FIFO would block the open
     Reader r(path);
     // Archive::readHeader
-    if (r.size() < 8 || r.get<int64_t>("magic number") != kMagic) throw Error(path, "not an OpenVDB file (bad magic number)");
+    if (r.size() < 8 || r.get<int64_t>("magic number") != kMagic)
+        throw Error(path, "not an OpenVDB file (bad magic number)");
     const uint32_t version = r.get<uint32_t>("file version");
     if (version < kMinVersion || version > kMaxVersion)
         r.fail("file format version " + std::to_string(version) + " (supported: " + std::to_string(kMinVersion) + "-" +
@@ -337,7 +347,8 @@ void checkVdbFile(const std::string& path) {
     // File::open: file metadata, grid count, grid descriptors (each followed by its grid).
     checkMetaMap(r, "file metadata");
     const int32_t grids = r.get<int32_t>("grid count");
-    if (grids < 0 || uint64_t(grids) * 36 > r.left()) r.fail("grid count " + std::to_string(grids) + " does not fit in the file");
+    if (grids < 0 || uint64_t(grids) * 36 > r.left())
+        r.fail("grid count " + std::to_string(grids) + " does not fit in the file");
     std::set<std::string> names;
     std::vector<std::string> parents;
     for (int32_t g = 0; g < grids; ++g) {
@@ -346,7 +357,8 @@ void checkVdbFile(const std::string& path) {
         const std::string name = r.str("grid name", 1u << 20);
         std::string type = r.str("grid type", 1024);
         const std::string suffix = "_HalfFloat";
-        const bool half = type.size() > suffix.size() && type.compare(type.size() - suffix.size(), suffix.size(), suffix) == 0;
+        const bool half =
+            type.size() > suffix.size() && type.compare(type.size() - suffix.size(), suffix.size(), suffix) == 0;
         if (half) type.resize(type.size() - suffix.size());
         const std::string parent = r.str("instance parent name", 1u << 20);
         const int64_t gridPos = r.get<int64_t>("grid position");
@@ -354,7 +366,8 @@ void checkVdbFile(const std::string& path) {
         const int64_t endPos = r.get<int64_t>("grid end position");
         if (gridPos < int64_t(r.pos()) || blockPos < gridPos || endPos < blockPos || uint64_t(endPos) > r.size())
             r.fail("grid '" + name.substr(0, 64) + "' has inconsistent offsets " + std::to_string(gridPos) + ", " +
-                   std::to_string(blockPos) + ", " + std::to_string(endPos) + " (file size " + std::to_string(r.size()) + ")");
+                   std::to_string(blockPos) + ", " + std::to_string(endPos) + " (file size " +
+                   std::to_string(r.size()) + ")");
         names.insert(name);
         if (!parent.empty()) parents.push_back(parent);
         // Archive::readGrid: compression flags, metadata, transform, topology (up to the block
@@ -362,7 +375,8 @@ void checkVdbFile(const std::string& path) {
         r.seek(uint64_t(gridPos));
         r.setLimit(uint64_t(blockPos), "the grid's block position");
         const uint32_t compression = r.get<uint32_t>("grid compression flags");
-        if (compression > (kZip | kActiveMask | kBlosc)) r.fail("grid compression flags " + std::to_string(compression));
+        if (compression > (kZip | kActiveMask | kBlosc))
+            r.fail("grid compression flags " + std::to_string(compression));
         checkMetaMap(r, "grid metadata");
         checkMap(r, 0);
         TreeSpec spec;

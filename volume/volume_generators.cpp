@@ -53,8 +53,10 @@ VolumeGrid makeSheppLogan(int n, Storage storage) {
                     if (u * u + w * w + h * h <= 1.0f) v += e.a;
                 }
                 const float st = std::round(std::clamp(v, 0.0f, 1.0f) * q);
-                if (storage == Storage::U8) g.bytes[g.index(i, j, k)] = uint8_t(st);
-                else g.data<uint16_t>()[g.index(i, j, k)] = uint16_t(st);
+                if (storage == Storage::U8)
+                    g.bytes[g.index(i, j, k)] = uint8_t(st);
+                else
+                    g.data<uint16_t>()[g.index(i, j, k)] = uint16_t(st);
             }
         }
     });

@@ -27,7 +27,7 @@ struct VolumeGrid {
     Vec3f spacing{1, 1, 1};
     Vec3f origin{0, 0, 0};
     Storage storage = Storage::U8;
-    std::string sourceType;  // type in the file (u8, i16, f64, ...)
+    std::string sourceType;             // type in the file (u8, i16, f64, ...)
     float scale = 1.0f, offset = 0.0f;  // data value = stored * scale + offset
     VolumeMetadata meta;
     // Stored voxels, x fastest, plus kPad bytes so wide gathers may over-read.
@@ -35,17 +35,26 @@ struct VolumeGrid {
     static constexpr size_t kPad = 16;
 
     size_t voxelCount() const { return size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]); }
-    size_t index(int i, int j, int k) const { return (size_t(k) * size_t(dims[1]) + size_t(j)) * size_t(dims[0]) + size_t(i); }
+    size_t index(int i, int j, int k) const {
+        return (size_t(k) * size_t(dims[1]) + size_t(j)) * size_t(dims[0]) + size_t(i);
+    }
     template <class T>
-    const T* data() const { return reinterpret_cast<const T*>(bytes.data()); }
+    const T* data() const {
+        return reinterpret_cast<const T*>(bytes.data());
+    }
     template <class T>
-    T* data() { return reinterpret_cast<T*>(bytes.data()); }
+    T* data() {
+        return reinterpret_cast<T*>(bytes.data());
+    }
     // Stored value (before scale/offset) of voxel n.
     float stored(size_t n) const {
         switch (storage) {
-            case Storage::U8: return float(bytes[n]);
-            case Storage::U16: return float(data<uint16_t>()[n]);
-            default: return data<float>()[n];
+            case Storage::U8:
+                return float(bytes[n]);
+            case Storage::U16:
+                return float(data<uint16_t>()[n]);
+            default:
+                return data<float>()[n];
         }
     }
     float value(size_t n) const { return stored(n) * scale + offset; }

@@ -26,8 +26,8 @@ struct VolumeIntegrator {
             constexpr int W = Packet<N>::W;
             Vec3<W> col;
             Packet<W> alpha, depth;
-            march<W>(s, rays.org.chunk(k), rays.dir.chunk(k), rays.tMin.chunk(k), rays.tMax.chunk(k), active.chunk(k), col,
-                     alpha, depth, samples, skipped);
+            march<W>(s, rays.org.chunk(k), rays.dir.chunk(k), rays.tMin.chunk(k), rays.tMax.chunk(k), active.chunk(k),
+                     col, alpha, depth, samples, skipped);
             r.color.setChunk(k, col);
             r.alpha.chunk(k) = alpha;
             r.depth.chunk(k) = depth;
@@ -46,7 +46,8 @@ struct VolumeIntegrator {
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
     // `knownStart`: the brick's first sample when the caller already looked it up.
     template <int W, class Scene>
-    static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p, const Packet<W, int32_t>* knownStart = nullptr) {
+    static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p,
+                                          const Packet<W, int32_t>* knownStart = nullptr) {
         const bool haveStart = knownStart != nullptr;
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
@@ -70,7 +71,8 @@ struct VolumeIntegrator {
     template <int W, class Scene>
     static RTFACT_INLINE Vec3<W> clampToGrid(const Scene& s, const Vec3<W>& p) {
         using P = Packet<W>;
-        return {clamp(p.x, P(0.0f), P(s.clampHi.x)), clamp(p.y, P(0.0f), P(s.clampHi.y)), clamp(p.z, P(0.0f), P(s.clampHi.z))};
+        return {clamp(p.x, P(0.0f), P(s.clampHi.x)), clamp(p.y, P(0.0f), P(s.clampHi.y)),
+                clamp(p.z, P(0.0f), P(s.clampHi.z))};
     }
     // Central-difference gradient in world units (stored values per world distance).
     template <int W, class Scene>
@@ -80,7 +82,8 @@ struct VolumeIntegrator {
             Vec3<W> lo = p, hi = p;
             lo[a] = lo[a] - Packet<W>(1.0f);
             hi[a] = hi[a] + Packet<W>(1.0f);
-            g[a] = (sample<W>(s, clampToGrid<W>(s, hi)) - sample<W>(s, clampToGrid<W>(s, lo))) * Packet<W>(0.5f * s.invSpacing[a]);
+            g[a] = (sample<W>(s, clampToGrid<W>(s, hi)) - sample<W>(s, clampToGrid<W>(s, lo))) *
+                   Packet<W>(0.5f * s.invSpacing[a]);
         }
         return g;
     }
@@ -216,7 +219,8 @@ struct VolumeIntegrator {
                         const Vec3<W> ph = clampToGrid<W>(s, oi + di * th);
                         const Vec3<W> g = gradient<W>(s, ph);
                         const I idx = tfIndex<W>(s, isoV);
-                        const Vec3<W> c(gather(s.tf.r.data(), idx), gather(s.tf.g.data(), idx), gather(s.tf.b.data(), idx));
+                        const Vec3<W> c(gather(s.tf.r.data(), idx), gather(s.tf.g.data(), idx),
+                                        gather(s.tf.b.data(), idx));
                         const Vec3<W> sh = c * shadeFactor<W>(g, d);
                         col = select(cross, sh, col);
                         alpha = select(cross, P(1.0f), alpha);

@@ -30,10 +30,18 @@ namespace {
 enum class Src { U8, I8, U16, I16, U32, I32, F32, F64 };
 int srcBytes(Src s) {
     switch (s) {
-        case Src::U8: case Src::I8: return 1;
-        case Src::U16: case Src::I16: return 2;
-        case Src::U32: case Src::I32: case Src::F32: return 4;
-        default: return 8;
+        case Src::U8:
+        case Src::I8:
+            return 1;
+        case Src::U16:
+        case Src::I16:
+            return 2;
+        case Src::U32:
+        case Src::I32:
+        case Src::F32:
+            return 4;
+        default:
+            return 8;
     }
 }
 const char* srcName(Src s) {
@@ -156,7 +164,8 @@ class ByteStream {
         if (r == Z_OK || (r == Z_BUF_ERROR && (z_.avail_in == 0 || z_.avail_in != before))) return;
         const std::string msg = z_.msg ? z_.msg : "error " + std::to_string(r);
         if (msg == "incorrect data check" || msg == "incorrect length check")
-            throw Error(path_, "corrupt compressed data: " + trailer() + " trailer does not match the data (zlib: " + msg + ")");
+            throw Error(path_, "corrupt compressed data: " + trailer() +
+                                   " trailer does not match the data (zlib: " + msg + ")");
         throw Error(path_, "corrupt compressed data (zlib: " + msg + ")");
     }
     std::string format() const { return gzip_ ? "gzip" : "zlib"; }
@@ -175,8 +184,8 @@ class ByteStream {
 // One piece of the voxel payload: `bytes` decoded bytes from `path`.
 struct Piece {
     std::string path;
-    uint64_t offset = 0;     // in the file (before decompression)
-    uint64_t skip = 0;       // decoded bytes to drop first
+    uint64_t offset = 0;  // in the file (before decompression)
+    uint64_t skip = 0;    // decoded bytes to drop first
     bool compressed = false;
     uint64_t bytes = 0;
     bool skipFromEnd = false;  // NRRD "byte skip: -1": data are the last bytes of the file
@@ -187,16 +196,22 @@ void checkPieces(const std::string& header, std::vector<Piece>& pieces) {
     for (Piece& p : pieces) {
         const uint64_t fsz = fileSize(p.path);
         if (p.skipFromEnd && !p.compressed) {
-            if (fsz < p.bytes) throw Error(p.path, "data file holds " + std::to_string(fsz) + " bytes, header needs " + std::to_string(p.bytes));
+            if (fsz < p.bytes)
+                throw Error(p.path, "data file holds " + std::to_string(fsz) + " bytes, header needs " +
+                                        std::to_string(p.bytes));
             p.offset = fsz - p.bytes;
             p.skip = 0;
         }
-        if (p.offset > fsz) throw Error(p.path, "data offset " + std::to_string(p.offset) + " is beyond the end of the file (" + std::to_string(fsz) + " bytes)");
+        if (p.offset > fsz)
+            throw Error(p.path, "data offset " + std::to_string(p.offset) + " is beyond the end of the file (" +
+                                    std::to_string(fsz) + " bytes)");
         const uint64_t avail = fsz - p.offset;
         if (!p.compressed) {
             if (avail < p.skip + p.bytes)
-                throw Error(p.path, "size mismatch: header " + (header == p.path ? std::string() : "(" + header + ") ") +
-                                        "needs " + std::to_string(p.skip + p.bytes) + " bytes of data, file has " + std::to_string(avail));
+                throw Error(p.path, "size mismatch: header " +
+                                        (header == p.path ? std::string() : "(" + header + ") ") + "needs " +
+                                        std::to_string(p.skip + p.bytes) + " bytes of data, file has " +
+                                        std::to_string(avail));
         } else {
             // deflate cannot compress better than about 1032:1
             const double maxOut = double(avail) * 1032.0 + 65536.0;
@@ -209,9 +224,14 @@ void checkPieces(const std::string& header, std::vector<Piece>& pieces) {
 
 Storage storageFor(Src s) {
     switch (s) {
-        case Src::U8: case Src::I8: return Storage::U8;
-        case Src::U16: case Src::I16: return Storage::U16;
-        default: return Storage::F32;
+        case Src::U8:
+        case Src::I8:
+            return Storage::U8;
+        case Src::U16:
+        case Src::I16:
+            return Storage::U16;
+        default:
+            return Storage::F32;
     }
 }
 
@@ -232,7 +252,9 @@ void decodePayload(VolumeGrid& g, Src src, bool bigEndian, std::vector<Piece>& p
     const int sb = srcBytes(src);
     uint64_t total = 0;
     for (const Piece& p : pieces) total += p.bytes;
-    if (total != n * uint64_t(sb)) throw Error(header, "data pieces hold " + std::to_string(total) + " bytes, expected " + std::to_string(n * uint64_t(sb)));
+    if (total != n * uint64_t(sb))
+        throw Error(header, "data pieces hold " + std::to_string(total) + " bytes, expected " +
+                                std::to_string(n * uint64_t(sb)));
     checkPieces(header, pieces);
     g.sourceType = srcName(src);
     // The dense grid plus its bricked copy for rendering.
@@ -253,7 +275,9 @@ void decodePayload(VolumeGrid& g, Src src, bool bigEndian, std::vector<Piece>& p
             const size_t cnt = k / size_t(sb);
             const uint8_t* b = buf.data();
             switch (src) {
-                case Src::U8: std::memcpy(g.bytes.data() + voxel, b, cnt); break;
+                case Src::U8:
+                    std::memcpy(g.bytes.data() + voxel, b, cnt);
+                    break;
                 case Src::I8:
                     for (size_t i = 0; i < cnt; ++i) g.bytes[voxel + i] = uint8_t(b[i] ^ 0x80);
                     break;
@@ -272,10 +296,14 @@ void decodePayload(VolumeGrid& g, Src src, bool bigEndian, std::vector<Piece>& p
                     for (size_t i = 0; i < cnt; ++i) {
                         const uint8_t* q = b + size_t(sb) * i;
                         float v;
-                        if (src == Src::U32) v = float(loadLE<uint32_t>(q, swap));
-                        else if (src == Src::I32) v = float(loadLE<int32_t>(q, swap));
-                        else if (src == Src::F32) v = loadLE<float>(q, swap);
-                        else v = float(loadLE<double>(q, swap));
+                        if (src == Src::U32)
+                            v = float(loadLE<uint32_t>(q, swap));
+                        else if (src == Src::I32)
+                            v = float(loadLE<int32_t>(q, swap));
+                        else if (src == Src::F32)
+                            v = loadLE<float>(q, swap);
+                        else
+                            v = float(loadLE<double>(q, swap));
                         d[i] = std::isfinite(v) ? v : 0.0f;  // NaN/inf voxels read as 0
                     }
                 }
@@ -294,17 +322,53 @@ void decodePayload(VolumeGrid& g, Src src, bool bigEndian, std::vector<Piece>& p
 
 Src parseSrcType(const std::string& file, std::string t) {
     t = lower(trim(t));
-    static const std::map<std::string, Src> m = {
-        {"u8", Src::U8}, {"uint8", Src::U8}, {"uchar", Src::U8}, {"unsigned char", Src::U8}, {"uint8_t", Src::U8}, {"met_uchar", Src::U8},
-        {"i8", Src::I8}, {"int8", Src::I8}, {"signed char", Src::I8}, {"int8_t", Src::I8}, {"met_char", Src::I8}, {"char", Src::I8},
-        {"u16", Src::U16}, {"uint16", Src::U16}, {"ushort", Src::U16}, {"unsigned short", Src::U16}, {"unsigned short int", Src::U16},
-        {"uint16_t", Src::U16}, {"met_ushort", Src::U16},
-        {"i16", Src::I16}, {"int16", Src::I16}, {"short", Src::I16}, {"short int", Src::I16}, {"signed short", Src::I16},
-        {"signed short int", Src::I16}, {"int16_t", Src::I16}, {"met_short", Src::I16},
-        {"u32", Src::U32}, {"uint", Src::U32}, {"unsigned int", Src::U32}, {"uint32", Src::U32}, {"uint32_t", Src::U32}, {"met_uint", Src::U32},
-        {"i32", Src::I32}, {"int", Src::I32}, {"signed int", Src::I32}, {"int32", Src::I32}, {"int32_t", Src::I32}, {"met_int", Src::I32},
-        {"f32", Src::F32}, {"float", Src::F32}, {"float32", Src::F32}, {"met_float", Src::F32},
-        {"f64", Src::F64}, {"double", Src::F64}, {"float64", Src::F64}, {"met_double", Src::F64}};
+    static const std::map<std::string, Src> m = {{"u8", Src::U8},
+                                                 {"uint8", Src::U8},
+                                                 {"uchar", Src::U8},
+                                                 {"unsigned char", Src::U8},
+                                                 {"uint8_t", Src::U8},
+                                                 {"met_uchar", Src::U8},
+                                                 {"i8", Src::I8},
+                                                 {"int8", Src::I8},
+                                                 {"signed char", Src::I8},
+                                                 {"int8_t", Src::I8},
+                                                 {"met_char", Src::I8},
+                                                 {"char", Src::I8},
+                                                 {"u16", Src::U16},
+                                                 {"uint16", Src::U16},
+                                                 {"ushort", Src::U16},
+                                                 {"unsigned short", Src::U16},
+                                                 {"unsigned short int", Src::U16},
+                                                 {"uint16_t", Src::U16},
+                                                 {"met_ushort", Src::U16},
+                                                 {"i16", Src::I16},
+                                                 {"int16", Src::I16},
+                                                 {"short", Src::I16},
+                                                 {"short int", Src::I16},
+                                                 {"signed short", Src::I16},
+                                                 {"signed short int", Src::I16},
+                                                 {"int16_t", Src::I16},
+                                                 {"met_short", Src::I16},
+                                                 {"u32", Src::U32},
+                                                 {"uint", Src::U32},
+                                                 {"unsigned int", Src::U32},
+                                                 {"uint32", Src::U32},
+                                                 {"uint32_t", Src::U32},
+                                                 {"met_uint", Src::U32},
+                                                 {"i32", Src::I32},
+                                                 {"int", Src::I32},
+                                                 {"signed int", Src::I32},
+                                                 {"int32", Src::I32},
+                                                 {"int32_t", Src::I32},
+                                                 {"met_int", Src::I32},
+                                                 {"f32", Src::F32},
+                                                 {"float", Src::F32},
+                                                 {"float32", Src::F32},
+                                                 {"met_float", Src::F32},
+                                                 {"f64", Src::F64},
+                                                 {"double", Src::F64},
+                                                 {"float64", Src::F64},
+                                                 {"met_double", Src::F64}};
     auto it = m.find(t);
     if (it == m.end()) throw Error(file, "unsupported voxel type '" + t + "'");
     return it->second;
@@ -320,7 +384,8 @@ std::vector<std::string> splitWords(const std::string& s) {
 double parseNumber(const std::string& file, const std::string& s, const std::string& what) {
     char* end = nullptr;
     const double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end == s.c_str() || *end != '\0' || !std::isfinite(v)) throw Error(file, "bad " + what + " '" + s + "'");
+    if (s.empty() || end == s.c_str() || *end != '\0' || !std::isfinite(v))
+        throw Error(file, "bad " + what + " '" + s + "'");
     return v;
 }
 
@@ -391,9 +456,10 @@ VolumeGrid loadRaw(const std::string& path, const VolumeLoadOptions& o) {
     const uint64_t need = g.voxelCount() * uint64_t(srcBytes(src));
     const uint64_t fsz = fileSize(path);
     if (fsz != o.headerSkip + need)
-        throw Error(path, "raw size mismatch: dims and type need " + std::to_string(need) + " bytes" +
-                              (o.headerSkip ? " after a " + std::to_string(o.headerSkip) + "-byte header" : std::string()) +
-                              ", file has " + std::to_string(fsz));
+        throw Error(path,
+                    "raw size mismatch: dims and type need " + std::to_string(need) + " bytes" +
+                        (o.headerSkip ? " after a " + std::to_string(o.headerSkip) + "-byte header" : std::string()) +
+                        ", file has " + std::to_string(fsz));
     std::vector<Piece> pieces{{path, o.headerSkip, 0, false, need}};
     decodePayload(g, src, lower(o.endian) == "big", pieces, path, o.progress);
     return g;
@@ -410,8 +476,10 @@ VolumeGrid loadMetaImage(const std::string& path, const VolumeLoadOptions& o) {
     while (pos < head.size()) {
         size_t e = head.find('\n', pos);
         if (e == std::string::npos) {
-            if (head.size() == fsz) e = head.size();
-            else throw Error(path, "MetaImage header line too long or header not terminated");
+            if (head.size() == fsz)
+                e = head.size();
+            else
+                throw Error(path, "MetaImage header line too long or header not terminated");
         }
         const std::string line = head.substr(pos, e - pos);
         pos = e + 1;
@@ -427,9 +495,13 @@ VolumeGrid loadMetaImage(const std::string& path, const VolumeLoadOptions& o) {
         }
     }
     if (!haveData) throw Error(path, "MetaImage header has no ElementDataFile");
-    auto get = [&](const char* k) -> std::string { auto it = kv.find(k); return it == kv.end() ? std::string() : it->second; };
+    auto get = [&](const char* k) -> std::string {
+        auto it = kv.find(k);
+        return it == kv.end() ? std::string() : it->second;
+    };
     const std::string ndims = get("ndims");
-    if (!ndims.empty() && ndims != "3") throw Error(path, "MetaImage NDims = " + ndims + ": only 3D volumes are supported");
+    if (!ndims.empty() && ndims != "3")
+        throw Error(path, "MetaImage NDims = " + ndims + ": only 3D volumes are supported");
     const auto ds = splitWords(get("dimsize"));
     if (ds.size() != 3) throw Error(path, "MetaImage DimSize must have 3 values");
     std::vector<int64_t> d;
@@ -454,7 +526,8 @@ VolumeGrid loadMetaImage(const std::string& path, const VolumeLoadOptions& o) {
         for (int a = 0; a < 3 && a < int(w.size()); ++a) g.origin[a] = float(parseNumber(path, w[a], "Offset"));
     }
     const std::string ch = get("elementnumberofchannels");
-    if (!ch.empty() && ch != "1") throw Error(path, "MetaImage with " + ch + " channels: only scalar volumes are supported");
+    if (!ch.empty() && ch != "1")
+        throw Error(path, "MetaImage with " + ch + " channels: only scalar volumes are supported");
     if (get("elementtype").empty()) throw Error(path, "MetaImage header has no ElementType");
     const Src src = parseSrcType(path, get("elementtype"));
     std::string msb = lower(get("elementbyteordermsb"));
@@ -471,7 +544,8 @@ VolumeGrid loadMetaImage(const std::string& path, const VolumeLoadOptions& o) {
     if (lower(df) == "local") {
         pieces.push_back({path, dataStart, 0, compressed, bytes});
     } else {
-        if (df.find("%") != std::string::npos || lower(df) == "list") throw Error(path, "MetaImage slice lists are not supported");
+        if (df.find("%") != std::string::npos || lower(df) == "list")
+            throw Error(path, "MetaImage slice lists are not supported");
         const std::string dp = (fs::path(path).parent_path() / df).string();
         Piece p{dp, 0, 0, compressed, bytes};
         if (headerSize > 0) p.offset = uint64_t(headerSize);
@@ -523,10 +597,14 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
         const std::string key = lower(trim(line.substr(0, c)));
         const std::string val = trim(line.substr(c + 2));
         kv[key] = val;
-        if ((key == "data file" || key == "datafile") && lower(splitWords(val).empty() ? "" : splitWords(val)[0]) == "list")
+        if ((key == "data file" || key == "datafile") &&
+            lower(splitWords(val).empty() ? "" : splitWords(val)[0]) == "list")
             listMode = true;
     }
-    auto get = [&](const char* k) -> std::string { auto it = kv.find(k); return it == kv.end() ? std::string() : it->second; };
+    auto get = [&](const char* k) -> std::string {
+        auto it = kv.find(k);
+        return it == kv.end() ? std::string() : it->second;
+    };
     std::string dataFile = get("data file");
     if (dataFile.empty()) dataFile = get("datafile");
     if (!blank && dataFile.empty()) throw Error(path, "NRRD header not terminated by a blank line");
@@ -546,8 +624,10 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
     if (sizes.size() == 4 && sizes[0] == 1) sizes.erase(sizes.begin());
     VolumeGrid g;
     setDims(g, path, sizes);
-    if (const std::string m = modalityTerm(nrrdModality); !m.empty()) g.meta = {m, "NRRD modality"};
-    else if (const std::string w = modalityWord(get("content")); !w.empty()) g.meta = {w, "NRRD content"};
+    if (const std::string m = modalityTerm(nrrdModality); !m.empty())
+        g.meta = {m, "NRRD modality"};
+    else if (const std::string w = modalityWord(get("content")); !w.empty())
+        g.meta = {w, "NRRD content"};
     if (!get("spacings").empty()) {
         std::vector<double> s;
         for (auto& w : splitWords(get("spacings")))
@@ -582,8 +662,10 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
     }
     const std::string enc = lower(get("encoding"));
     bool compressed = false;
-    if (enc == "gzip" || enc == "gz") compressed = true;
-    else if (enc != "raw") throw Error(path, "NRRD encoding '" + enc + "' is not supported (raw, gzip)");
+    if (enc == "gzip" || enc == "gz")
+        compressed = true;
+    else if (enc != "raw")
+        throw Error(path, "NRRD encoding '" + enc + "' is not supported (raw, gzip)");
     const std::string endian = lower(get("endian"));
     const bool big = endian == "big";
     int64_t byteSkip = 0, lineSkip = 0;
@@ -606,7 +688,8 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
         };
         const long lo = index(words[1], "data file min"), hi = index(words[2], "data file max");
         const long step = index(words[3], "data file step");
-        if (step == 0 || (hi - lo) / step < 0 || (hi - lo) / step > 1000000) throw Error(path, "bad NRRD data file range");
+        if (step == 0 || (hi - lo) / step < 0 || (hi - lo) / step > 1000000)
+            throw Error(path, "bad NRRD data file range");
         // The pattern comes from the file: never hand it to printf (fuzz_volume_headers found a
         // crash with "%s"); only one %d with an optional zero-padded width is accepted.
         const std::string& pat = words[0];
@@ -615,7 +698,8 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
         const bool zero = q < pat.size() && pat[q] == '0';
         q += zero;
         int width = 0;
-        while (q < pat.size() && std::isdigit(static_cast<unsigned char>(pat[q])) && width < 100) width = width * 10 + (pat[q++] - '0');
+        while (q < pat.size() && std::isdigit(static_cast<unsigned char>(pat[q])) && width < 100)
+            width = width * 10 + (pat[q++] - '0');
         if (q >= pat.size() || pat[q] != 'd' || width > 32 || pat.find('%', q) != std::string::npos)
             throw Error(path, "bad NRRD data file pattern '" + pat.substr(0, 64) + "' (one %d expected)");
         for (long i = lo; step > 0 ? i <= hi : i >= hi; i += step) {
@@ -628,7 +712,8 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
         files.push_back((dir / dataFile).string());
     }
     if (files.empty()) throw Error(path, "NRRD lists no data files");
-    if (bytes % files.size() != 0) throw Error(path, "NRRD data is not evenly split over " + std::to_string(files.size()) + " files");
+    if (bytes % files.size() != 0)
+        throw Error(path, "NRRD data is not evenly split over " + std::to_string(files.size()) + " files");
     const uint64_t per = bytes / files.size();
     std::vector<Piece> pieces;
     for (const std::string& f : files) {
@@ -646,9 +731,12 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
             }
             p.offset = q;
         }
-        if (byteSkip == -1) p.skipFromEnd = true;
-        else if (compressed) p.skip = uint64_t(byteSkip);
-        else p.offset += uint64_t(byteSkip);
+        if (byteSkip == -1)
+            p.skipFromEnd = true;
+        else if (compressed)
+            p.skip = uint64_t(byteSkip);
+        else
+            p.offset += uint64_t(byteSkip);
         pieces.push_back(p);
     }
     decodePayload(g, src, big, pieces, path, o.progress);
@@ -674,8 +762,9 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
         if (sz != 348) throw Error(path, "not a NIfTI-1 file (sizeof_hdr is not 348)");
     }
     if (std::memcmp(h + 344, "n+1", 4) != 0)
-        throw Error(path, std::memcmp(h + 344, "ni1", 4) == 0 ? "NIfTI .hdr/.img pairs are not supported; use a single .nii"
-                                                               : "bad NIfTI magic (expected n+1)");
+        throw Error(path, std::memcmp(h + 344, "ni1", 4) == 0
+                              ? "NIfTI .hdr/.img pairs are not supported; use a single .nii"
+                              : "bad NIfTI magic (expected n+1)");
     auto i16 = [&](int off) { return loadLE<int16_t>(h + off, swap); };
     auto f32 = [&](int off) { return loadLE<float>(h + off, swap); };
     const int nd = i16(40);
@@ -683,23 +772,43 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
     std::vector<int64_t> d = {1, 1, 1};
     for (int a = 0; a < nd; ++a) {
         const int64_t v = i16(42 + 2 * a);
-        if (a < 3) d[size_t(a)] = v;
-        else if (v > 1) throw Error(path, "NIfTI with " + std::to_string(nd) + " dimensions (dim[" + std::to_string(a + 1) + "] = " + std::to_string(v) + "): only 3D volumes are supported");
+        if (a < 3)
+            d[size_t(a)] = v;
+        else if (v > 1)
+            throw Error(path, "NIfTI with " + std::to_string(nd) + " dimensions (dim[" + std::to_string(a + 1) +
+                                  "] = " + std::to_string(v) + "): only 3D volumes are supported");
     }
     VolumeGrid g;
     setDims(g, path, d);
     const int dt = i16(70);
     Src src;
     switch (dt) {
-        case 2: src = Src::U8; break;
-        case 4: src = Src::I16; break;
-        case 8: src = Src::I32; break;
-        case 16: src = Src::F32; break;
-        case 64: src = Src::F64; break;
-        case 256: src = Src::I8; break;
-        case 512: src = Src::U16; break;
-        case 768: src = Src::U32; break;
-        default: throw Error(path, "unsupported NIfTI datatype " + std::to_string(dt));
+        case 2:
+            src = Src::U8;
+            break;
+        case 4:
+            src = Src::I16;
+            break;
+        case 8:
+            src = Src::I32;
+            break;
+        case 16:
+            src = Src::F32;
+            break;
+        case 64:
+            src = Src::F64;
+            break;
+        case 256:
+            src = Src::I8;
+            break;
+        case 512:
+            src = Src::U16;
+            break;
+        case 768:
+            src = Src::U32;
+            break;
+        default:
+            throw Error(path, "unsupported NIfTI datatype " + std::to_string(dt));
     }
     std::vector<double> sp;
     for (int a = 0; a < 3; ++a) {
@@ -710,8 +819,10 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
     const float vox = f32(108);
     if (!std::isfinite(vox) || vox < 348 || vox > float(fsz) * 1100.0f) throw Error(path, "bad NIfTI vox_offset");
     // NIfTI has no modality field; its free-text descrip or aux_file may name one.
-    if (const std::string w = modalityWord(headerText(h + 148, 80)); !w.empty()) g.meta = {w, "NIfTI descrip"};
-    else if (const std::string a = modalityWord(headerText(h + 228, 24)); !a.empty()) g.meta = {a, "NIfTI aux_file"};
+    if (const std::string w = modalityWord(headerText(h + 148, 80)); !w.empty())
+        g.meta = {w, "NIfTI descrip"};
+    else if (const std::string a = modalityWord(headerText(h + 228, 24)); !a.empty())
+        g.meta = {a, "NIfTI aux_file"};
     const float slope = f32(112), inter = f32(116);
     if (std::isfinite(slope) && slope != 0.0f) {
         g.scale = slope;
@@ -719,8 +830,10 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
     }
     const uint64_t bytes = g.voxelCount() * uint64_t(srcBytes(src));
     std::vector<Piece> pieces;
-    if (gz) pieces.push_back({path, 0, uint64_t(vox), true, bytes});
-    else pieces.push_back({path, uint64_t(vox), 0, false, bytes});
+    if (gz)
+        pieces.push_back({path, 0, uint64_t(vox), true, bytes});
+    else
+        pieces.push_back({path, uint64_t(vox), 0, false, bytes});
     decodePayload(g, src, swap, pieces, path, o.progress);
     return g;
 }
@@ -730,10 +843,12 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
 uint64_t checkedVoxelCount(const std::string& file, const int64_t dims[3]) {
     uint64_t n = 1;
     for (int a = 0; a < 3; ++a) {
-        if (dims[a] <= 0) throw Error(file, "bad dimensions " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]) + ": every size must be positive");
+        if (dims[a] <= 0)
+            throw Error(file, "bad dimensions " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+                                  std::to_string(dims[2]) + ": every size must be positive");
         if (uint64_t(dims[a]) > kMaxVoxels || __builtin_mul_overflow(n, uint64_t(dims[a]), &n) || n > kMaxVoxels)
-            throw Error(file, "dimensions " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]) +
-                                  " are too large (at most 2^31-1 voxels are supported)");
+            throw Error(file, "dimensions " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
+                                  std::to_string(dims[2]) + " are too large (at most 2^31-1 voxels are supported)");
     }
     return n;
 }
@@ -787,13 +902,20 @@ VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt) {
     const bool dir = requireFileOrDirectory(path);  // before any reader opens it: a FIFO would block
     const std::string p = lower(path);
     VolumeGrid g;
-    if (dir) g = loadDicomSeries(path, opt);
-    else if (opt.dims || !opt.type.empty()) g = loadRaw(path, opt);
-    else if (endsWith(p, ".mhd") || endsWith(p, ".mha")) g = loadMetaImage(path, opt);
-    else if (endsWith(p, ".nrrd") || endsWith(p, ".nhdr")) g = loadNrrd(path, opt);
-    else if (endsWith(p, ".nii") || endsWith(p, ".nii.gz")) g = loadNifti(path, opt);
-    else if (endsWith(p, ".vti")) g = loadVTI(path, opt);
-    else if (endsWith(p, ".vdb")) g = loadVDB(path, opt);
+    if (dir)
+        g = loadDicomSeries(path, opt);
+    else if (opt.dims || !opt.type.empty())
+        g = loadRaw(path, opt);
+    else if (endsWith(p, ".mhd") || endsWith(p, ".mha"))
+        g = loadMetaImage(path, opt);
+    else if (endsWith(p, ".nrrd") || endsWith(p, ".nhdr"))
+        g = loadNrrd(path, opt);
+    else if (endsWith(p, ".nii") || endsWith(p, ".nii.gz"))
+        g = loadNifti(path, opt);
+    else if (endsWith(p, ".vti"))
+        g = loadVTI(path, opt);
+    else if (endsWith(p, ".vdb"))
+        g = loadVDB(path, opt);
     else if (endsWith(p, ".raw")) {
         // name_XxYxZ_type.raw (the Open SciVis naming) carries dims and type
         VolumeLoadOptions o = opt;
@@ -807,8 +929,8 @@ VolumeGrid loadVolume(const std::string& path, const VolumeLoadOptions& opt) {
             o.type = t == "uint8" ? "u8" : t == "uint16" ? "u16" : t == "int16" ? "i16" : t == "float32" ? "f32" : t;
         }
         g = loadRaw(path, o);
-    }
-    else throw Error(path, "unknown volume format (raw needs --dims and --type)");
+    } else
+        throw Error(path, "unknown volume format (raw needs --dims and --type)");
     if (opt.spacing) g.spacing = *opt.spacing;
     return g;
 }
@@ -831,7 +953,8 @@ BrickedVolume loadBrickedVolume(const std::string& path, const VolumeLoadOptions
 void writeRaw(const std::string& path, const VolumeGrid& g) {
     std::ofstream f(path, std::ios::binary);
     if (!f) throw Error(path, "cannot write file");
-    f.write(reinterpret_cast<const char*>(g.bytes.data()), std::streamsize(g.voxelCount() * size_t(storageBytes(g.storage))));
+    f.write(reinterpret_cast<const char*>(g.bytes.data()),
+            std::streamsize(g.voxelCount() * size_t(storageBytes(g.storage))));
     if (!f) throw Error(path, "write failed");
 }
 
@@ -843,7 +966,8 @@ void writeMetaImage(const std::string& mhdPath, const VolumeGrid& g) {
     const char* et = g.storage == Storage::U8 ? "MET_UCHAR" : (g.storage == Storage::U16 ? "MET_USHORT" : "MET_FLOAT");
     f << "ObjectType = Image\nNDims = 3\nDimSize = " << g.dims[0] << " " << g.dims[1] << " " << g.dims[2]
       << "\nElementSpacing = " << g.spacing.x << " " << g.spacing.y << " " << g.spacing.z
-      << "\nElementByteOrderMSB = False\nElementType = " << et << "\nElementDataFile = " << raw.filename().string() << "\n";
+      << "\nElementByteOrderMSB = False\nElementType = " << et << "\nElementDataFile = " << raw.filename().string()
+      << "\n";
 }
 
 VolumeSummary summarize(const VolumeGrid& g, int bins) {

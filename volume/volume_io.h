@@ -16,11 +16,11 @@ namespace rtfact::volume {
 struct VolumeLoadOptions {
     // Raw files (and overrides for any format where it makes sense).
     std::optional<std::array<int, 3>> dims;
-    std::string type;            // u8|u16|i16|f32 (raw only)
+    std::string type;  // u8|u16|i16|f32 (raw only)
     std::string endian = "little";
     std::optional<Vec3f> spacing;  // overrides the file's spacing
     uint64_t headerSkip = 0;
-    std::string grid;            // OpenVDB grid name; default the first float grid
+    std::string grid;  // OpenVDB grid name; default the first float grid
     bool progress = true;
 };
 

@@ -5,9 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <limits>
-
 #include <cmath>
+#include <limits>
 
 #include "core/util/error.h"
 #include "core/util/input_file.h"
@@ -34,7 +33,8 @@ openvdb::FloatGrid::Ptr readFloatGrid(const std::string& path, const VolumeLoadO
         for (auto& m : *metas) {
             if (!opt.grid.empty() && m->getName() != opt.grid) continue;
             if (m->valueType() != "float") {
-                if (!opt.grid.empty()) throw Error(path, "grid '" + opt.grid + "' holds " + m->valueType() + " values, not float");
+                if (!opt.grid.empty())
+                    throw Error(path, "grid '" + opt.grid + "' holds " + m->valueType() + " values, not float");
                 continue;
             }
             name = m->getName();
@@ -106,11 +106,13 @@ BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& o
     int dims[3];
     for (int a = 0; a < 3; ++a) {
         const int64_t d = int64_t(bb.max()[a]) - int64_t(bb.min()[a]) + 1;
-        if (d > (int64_t(1) << 20)) throw Error(path, "active bounding box is too large (" + std::to_string(d) + " voxels along an axis)");
+        if (d > (int64_t(1) << 20))
+            throw Error(path, "active bounding box is too large (" + std::to_string(d) + " voxels along an axis)");
         dims[a] = int(std::max<int64_t>(d, 2));
     }
     const uint64_t bricks = uint64_t((dims[0] + 6) / 8) * uint64_t((dims[1] + 6) / 8) * uint64_t((dims[2] + 6) / 8);
-    if (bricks > (uint64_t(1) << 28)) throw Error(path, "active bounding box needs too many bricks (" + std::to_string(bricks) + ")");
+    if (bricks > (uint64_t(1) << 28))
+        throw Error(path, "active bounding box needs too many bricks (" + std::to_string(bricks) + ")");
     BrickBuilder::init(v, dims, Storage::F32);
     const openvdb::Vec3d vs = grid->voxelSize();
     const openvdb::Vec3d o = grid->indexToWorld(bb.min());
@@ -118,7 +120,8 @@ BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& o
         v.spacing[a] = vs[a] > 0 ? float(vs[a]) : 1.0f;
         v.origin[a] = float(o[a]);
     }
-    v.sourceType = "f32 (OpenVDB grid '" + name + "', " + std::to_string(grid->activeVoxelCount()) + " active voxels, sparse)";
+    v.sourceType =
+        "f32 (OpenVDB grid '" + name + "', " + std::to_string(grid->activeVoxelCount()) + " active voxels, sparse)";
     // Mark the bricks whose 9^3 samples touch a leaf node or an active tile.
     std::vector<uint8_t> used(v.brickCount(), 0);
     const openvdb::Coord m0 = bb.min();
@@ -149,7 +152,8 @@ BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& o
     for (size_t b = 0; b < used.size(); ++b)
         if (used[b]) list.push_back(b);
     const uint64_t poolFloats = (uint64_t(list.size()) + 1) * uint64_t(BrickedVolume::kBrick);
-    if (poolFloats > uint64_t(std::numeric_limits<int32_t>::max()) - 64) throw Error(path, "too many non-empty bricks for 32-bit offsets");
+    if (poolFloats > uint64_t(std::numeric_limits<int32_t>::max()) - 64)
+        throw Error(path, "too many non-empty bricks for 32-bit offsets");
     v.pool.assign(size_t(poolFloats) * 4 + 64, 0);
     float* pool = reinterpret_cast<float*>(v.pool.data());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size()), [&](const tbb::blocked_range<size_t>& r) {

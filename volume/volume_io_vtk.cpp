@@ -35,10 +35,13 @@ VolumeGrid fromImageData(const std::string& path, vtkImageData* img) {
     checkedVoxelCount(path, d);
     vtkDataArray* arr = img->GetPointData() ? img->GetPointData()->GetScalars() : nullptr;
     if (!arr) throw Error(path, "image has no scalar point data");
-    if (arr->GetNumberOfComponents() != 1) throw Error(path, "image scalars have " + std::to_string(arr->GetNumberOfComponents()) + " components; only scalar volumes are supported");
+    if (arr->GetNumberOfComponents() != 1)
+        throw Error(path, "image scalars have " + std::to_string(arr->GetNumberOfComponents()) +
+                              " components; only scalar volumes are supported");
     VolumeGrid g;
     for (int a = 0; a < 3; ++a) g.dims[a] = int(d[a]);
-    if (uint64_t(arr->GetNumberOfTuples()) != g.voxelCount()) throw Error(path, "scalar array size does not match the extent");
+    if (uint64_t(arr->GetNumberOfTuples()) != g.voxelCount())
+        throw Error(path, "scalar array size does not match the extent");
     double sp[3], org[3];
     img->GetSpacing(sp);
     img->GetOrigin(org);
@@ -107,12 +110,14 @@ VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
     // every DICOM file must at least hold one slice of pixel data.
     int ext[6];
     img->GetExtent(ext);
-    const uint64_t sliceBytes = uint64_t(ext[1] - ext[0] + 1) * uint64_t(ext[3] - ext[2] + 1) * uint64_t(img->GetScalarSize());
+    const uint64_t sliceBytes =
+        uint64_t(ext[1] - ext[0] + 1) * uint64_t(ext[3] - ext[2] + 1) * uint64_t(img->GetScalarSize());
     for (const auto& [path, size] : slices)
         if (size < sliceBytes + 132)
             throw Error(path.string(), "truncated DICOM slice: " + std::to_string(size) + " bytes, one " +
-                                           std::to_string(ext[1] - ext[0] + 1) + "x" + std::to_string(ext[3] - ext[2] + 1) +
-                                           " slice needs " + std::to_string(sliceBytes));
+                                           std::to_string(ext[1] - ext[0] + 1) + "x" +
+                                           std::to_string(ext[3] - ext[2] + 1) + " slice needs " +
+                                           std::to_string(sliceBytes));
     if (ext[5] - ext[4] + 1 != int(files))
         throw Error(dir, "VTK read " + std::to_string(ext[5] - ext[4] + 1) + " slices from " + std::to_string(files) +
                              " DICOM files (corrupt or mismatched slices)");
@@ -123,7 +128,8 @@ VolumeGrid loadDicomSeries(const std::string& dir, const VolumeLoadOptions&) {
         g.scale = slope;
     }
     g.sourceType += " (DICOM, " + std::to_string(files) + " files)";
-    if (const std::string m = readDicomModality(slices.front().first.string()); !m.empty()) g.meta = {m, "DICOM modality"};
+    if (const std::string m = readDicomModality(slices.front().first.string()); !m.empty())
+        g.meta = {m, "DICOM modality"};
     return g;
 }
 
@@ -140,14 +146,16 @@ VolumeGrid loadVTI(const std::string& path, const VolumeLoadOptions&) {
     const size_t p = head.find("WholeExtent=\"");
     if (p == std::string::npos) throw Error(path, "VTI without WholeExtent");
     long long e[6];
-    if (std::sscanf(head.c_str() + p + 13, "%lld %lld %lld %lld %lld %lld", &e[0], &e[1], &e[2], &e[3], &e[4], &e[5]) != 6)
+    if (std::sscanf(head.c_str() + p + 13, "%lld %lld %lld %lld %lld %lld", &e[0], &e[1], &e[2], &e[3], &e[4], &e[5]) !=
+        6)
         throw Error(path, "bad VTI WholeExtent");
     const int64_t d[3] = {e[1] - e[0] + 1, e[3] - e[2] + 1, e[5] - e[4] + 1};
     const uint64_t n = checkedVoxelCount(path, d);
     std::error_code ec;
     const uint64_t fsz = fs::file_size(path, ec);
     // Compressed (zlib) appended data can shrink at most ~1032:1.
-    if (double(n) > double(fsz) * 1100.0 + 4096.0) throw Error(path, "extent claims " + std::to_string(n) + " voxels, more than the file can hold");
+    if (double(n) > double(fsz) * 1100.0 + 4096.0)
+        throw Error(path, "extent claims " + std::to_string(n) + " voxels, more than the file can hold");
     QuietVtkOutput quiet;
     VtkErrors errs;
     vtkNew<vtkXMLImageDataReader> r;

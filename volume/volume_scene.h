@@ -2,14 +2,13 @@
 // f32): the grid in index space, the clip box, the transfer-function lookup table and
 // the per-mode brick occupancy. Built once per frame setup; the bricks are referenced.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/util/error.h"
-#include <algorithm>
-#include <limits>
-
 #include "volume/brick_volume.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_grid.h"
@@ -20,9 +19,9 @@ enum class VolumeMode { DVR, Shaded, MIP, Iso };
 
 struct VolumeRenderSettings {
     VolumeMode mode = VolumeMode::DVR;
-    float stepVoxels = 0.5f;  // ray-marching step in voxels (of the smallest spacing)
-    float iso = 0.0f;         // data units (iso mode)
-    bool skipping = true;     // empty-space skipping from the macrocells
+    float stepVoxels = 0.5f;                 // ray-marching step in voxels (of the smallest spacing)
+    float iso = 0.0f;                        // data units (iso mode)
+    bool skipping = true;                    // empty-space skipping from the macrocells
     Vec3f clipLo{0, 0, 0}, clipHi{1, 1, 1};  // fractions of each axis
     float earlyTermination = 0.99f;
 };
@@ -31,14 +30,14 @@ template <class T>
 struct VolumeScene {
     using Voxel = T;
     static constexpr int kCells = BrickedVolume::kCells, kEdge = BrickedVolume::kEdge;
-    const T* voxels = nullptr;      // brick pool
+    const T* voxels = nullptr;  // brick pool
     const int32_t* brickStart = nullptr;
     int dims[3] = {0, 0, 0};
-    int32_t nbx = 0, nbxy = 0;      // brick grid strides
+    int32_t nbx = 0, nbxy = 0;  // brick grid strides
     Vec3f origin, invSpacing, spacing;
-    Vec3f boxLo, boxHi;   // index space, after clipping
-    Vec3f clampHi;        // largest coordinate trilinear sampling may use per axis
-    float dt = 0.5f;      // world-space step
+    Vec3f boxLo, boxHi;  // index space, after clipping
+    Vec3f clampHi;       // largest coordinate trilinear sampling may use per axis
+    float dt = 0.5f;     // world-space step
     VolumeRenderSettings settings;
     // Transfer function: entry = stored * tfMul + tfAdd.
     TFTable tf;
@@ -83,15 +82,18 @@ struct VolumeScene {
         for (size_t i = 0; i < nc; ++i) {
             const float lo = v.cellLo[i] * v.scale + v.offset, hi = v.cellHi[i] * v.scale + v.offset;
             bool on = true;
-            if (s.mode == VolumeMode::DVR || s.mode == VolumeMode::Shaded) on = tf.visible(std::min(lo, hi), std::max(lo, hi));
-            else if (s.mode == VolumeMode::Iso) on = std::min(lo, hi) <= s.iso && s.iso <= std::max(lo, hi);
+            if (s.mode == VolumeMode::DVR || s.mode == VolumeMode::Shaded)
+                on = tf.visible(std::min(lo, hi), std::max(lo, hi));
+            else if (s.mode == VolumeMode::Iso)
+                on = std::min(lo, hi) <= s.iso && s.iso <= std::max(lo, hi);
             cellFlags[i] = (on || !s.skipping) ? 1 : 0;
         }
         brickInfo.resize(nc);
         for (size_t i = 0; i < nc; ++i) brickInfo[i] = v.brickStart[i] | (cellFlags[i] ? 0 : int32_t(0x80000000u));
         // MIP skips on stored maxima; a decreasing value map (negative scale) or no
         // skipping: never skip.
-        if (v.scale < 0 || !s.skipping) std::fill(cellMax.begin(), cellMax.end(), std::numeric_limits<float>::infinity());
+        if (v.scale < 0 || !s.skipping)
+            std::fill(cellMax.begin(), cellMax.end(), std::numeric_limits<float>::infinity());
     }
 
     AABB bounds() const { return {origin + boxLo * spacing, origin + boxHi * spacing}; }
@@ -102,9 +104,15 @@ struct VolumeScene {
 template <class F>
 void withVolumeScene(const BrickedVolume& v, const TFTable& tf, const VolumeRenderSettings& s, F&& f) {
     switch (v.storage) {
-        case Storage::U8: f(VolumeScene<uint8_t>(v, tf, s)); break;
-        case Storage::U16: f(VolumeScene<uint16_t>(v, tf, s)); break;
-        default: f(VolumeScene<float>(v, tf, s)); break;
+        case Storage::U8:
+            f(VolumeScene<uint8_t>(v, tf, s));
+            break;
+        case Storage::U16:
+            f(VolumeScene<uint16_t>(v, tf, s));
+            break;
+        default:
+            f(VolumeScene<float>(v, tf, s));
+            break;
     }
 }
 

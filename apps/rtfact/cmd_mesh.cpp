@@ -9,10 +9,10 @@
 
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/render_command.h"
+#include "core/render/ao_integrator.h"
 #include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
 #include "core/util/error.h"
-#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/path_integrator.h"
@@ -78,9 +78,11 @@ void applyMaterial(Mesh& m, const std::string& spec) {
         } catch (const std::exception&) {
             throw CLI::ValidationError("--material", "glass:IOR expects a number, got '" + arg + "'");
         }
-        if (!(mat.ior >= 1.0f && mat.ior <= 4.0f)) throw CLI::ValidationError("--material", "glass IOR must be in [1, 4]");
+        if (!(mat.ior >= 1.0f && mat.ior <= 4.0f))
+            throw CLI::ValidationError("--material", "glass IOR must be in [1, 4]");
     } else {
-        throw CLI::ValidationError("--material", "expected lambert[:r,g,b], mirror[:r,g,b] or glass[:ior], got '" + spec + "'");
+        throw CLI::ValidationError("--material",
+                                   "expected lambert[:r,g,b], mirror[:r,g,b] or glass[:ior], got '" + spec + "'");
     }
     m.materials = {mat};
     m.materialIds.assign(m.triangles(), 0);
@@ -127,8 +129,10 @@ int renderMesh(const MeshOpts& o, std::shared_ptr<const Mesh> mesh, Stats& stats
         renderToFile(scene, EyeLightIntegrator{}, c, frame, stats);
     } else if (incoherent) {
         stats.add("secondary", secondary);
-        if (secondary == "wide") renderSecondary<WideSecondaryRays>(o, scene, *mesh, frame, stats);
-        else renderSecondary<PacketSecondaryRays>(o, scene, *mesh, frame, stats);
+        if (secondary == "wide")
+            renderSecondary<WideSecondaryRays>(o, scene, *mesh, frame, stats);
+        else
+            renderSecondary<PacketSecondaryRays>(o, scene, *mesh, frame, stats);
     } else {
         LightList lights;
         for (const std::string& l : o.lights) lights.push_back(parseLight(l, box));
@@ -138,7 +142,8 @@ int renderMesh(const MeshOpts& o, std::shared_ptr<const Mesh> mesh, Stats& stats
             // blamed --light for any non-finite camera.
             const Vec3f e = box.extent();
             const float r = std::max(length(e), 1e-6f);
-            const Vec3f p = frame.eye + normalize(frame.up) * (0.8f * r) - normalize(cross(frame.at - frame.eye, frame.up)) * (0.6f * r);
+            const Vec3f p = frame.eye + normalize(frame.up) * (0.8f * r) -
+                            normalize(cross(frame.at - frame.eye, frame.up)) * (0.6f * r);
             lights.push_back(scaledPointLight(p, box));
         }
         if (o.integrator == "whitted") {
@@ -166,13 +171,19 @@ void addMeshCommand(CLI::App& app, CommandList& list) {
     cmd->add_option("--integrator", o->integrator, "eyelight|direct|whitted|ao|path (path: progressive, use --spp)")
         ->capture_default_str()
         ->check(CLI::IsMember({"eyelight", "direct", "whitted", "ao", "path"}));
-    cmd->add_option("--max-depth", o->maxDepth, "Whitted/path tracer: maximum ray depth")->capture_default_str()->check(CLI::Range(1, 64));
+    cmd->add_option("--max-depth", o->maxDepth, "Whitted/path tracer: maximum ray depth")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
     cmd->add_option("--light", o->lights, "Light point:x,y,z or dir:x,y,z (repeatable; default: a key light)");
-    cmd->add_option("--material", o->material, "Override all materials: lambert[:r,g,b] | mirror[:r,g,b] | glass[:ior] (mirror/glass: whitted, path)");
+    cmd->add_option(
+        "--material", o->material,
+        "Override all materials: lambert[:r,g,b] | mirror[:r,g,b] | glass[:ior] (mirror/glass: whitted, path)");
     cmd->add_option("--bvh", o->bvh, "Acceleration structure: sah (binned SAH BVH) | kdtree (SAH kd-tree)")
         ->capture_default_str()
         ->check(CLI::IsMember({"sah", "kdtree"}));
-    cmd->add_option("--ao-samples", o->aoSamples, "Ambient occlusion rays per hit")->capture_default_str()->check(CLI::Range(1, 1024));
+    cmd->add_option("--ao-samples", o->aoSamples, "Ambient occlusion rays per hit")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1024));
     cmd->add_option("--secondary", o->secondary,
                     "AO / path bounce rays: wide (single rays through a wide BVH), packet (the packet BVH) or auto "
                     "(AO: packet, path: wide)")
@@ -188,8 +199,10 @@ void addMeshCommand(CLI::App& app, CommandList& list) {
                         auto mesh = std::make_shared<Mesh>(loadMeshes(o->files));
                         applyMaterial(*mesh, o->material);
                         stats.add("load_ms", msSince(t0));
-                        if (o->bvh == "kdtree") renderMesh<KdTree<Triangle>>(*o, mesh, stats);
-                        else renderMesh<BVH<Triangle>>(*o, mesh, stats);
+                        if (o->bvh == "kdtree")
+                            renderMesh<KdTree<Triangle>>(*o, mesh, stats);
+                        else
+                            renderMesh<BVH<Triangle>>(*o, mesh, stats);
                         if (c.stats) stats.print();
                         return 0;
                     }});

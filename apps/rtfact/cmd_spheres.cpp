@@ -18,7 +18,9 @@ void addSpheresCommand(CLI::App& app, CommandList& list) {
     auto o = std::make_shared<Opts>();
     CLI::App* cmd = app.add_subcommand("spheres", "Render the analytic sphere demo scene");
     o->common.addTo(*cmd, "spheres.png");
-    cmd->add_option("--count", o->count, "Number of small spheres")->capture_default_str()->check(CLI::Range(0, 10000000));
+    cmd->add_option("--count", o->count, "Number of small spheres")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 10000000));
     cmd->add_option("--integrator", o->integrator, "eyelight|direct")
         ->capture_default_str()
         ->check(CLI::IsMember({"eyelight", "direct"}));
@@ -42,8 +44,9 @@ void addSpheresCommand(CLI::App& app, CommandList& list) {
                         } else {
                             DirectLightIntegrator integ;
                             const Vec3f e = focus.extent();
-                            integ.lights.push_back(PointLight{focus.center() + Vec3f(-0.6f * e.x, 2.0f * e.y + 0.5f * e.x, 0.4f * e.z),
-                                                              Vec3f(1.2f * dot(e, e))});
+                            integ.lights.push_back(
+                                PointLight{focus.center() + Vec3f(-0.6f * e.x, 2.0f * e.y + 0.5f * e.x, 0.4f * e.z),
+                                           Vec3f(1.2f * dot(e, e))});
                             integ.lights.push_back(DirectionalLight{{0.3f, -1.0f, -0.4f}, Vec3f(0.6f)});
                             renderToFile(scene, integ, c, frame, stats);
                         }

@@ -10,10 +10,10 @@
 #include "core/util/error.h"
 #include "volume/default_transfer_function.h"
 #include "volume/transfer_function.h"
+#include "volume/value_histogram.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
-#include "volume/value_histogram.h"
 #include "volume/volume_scene.h"
 
 namespace rtfact::app {
@@ -46,8 +46,11 @@ struct LoadArgs {
     uint64_t headerSkip = 0;
     void addTo(CLI::App& cmd) {
         cmd.add_option("--dims", dims, "Raw volume size X,Y,Z")->check(parsedBy(parseDims, "X,Y,Z"));
-        cmd.add_option("--type", type, "Raw voxel type u8|u16|i16|f32")->check(CLI::IsMember({"u8", "u16", "i16", "f32"}));
-        cmd.add_option("--endian", endian, "Raw byte order little|big")->capture_default_str()->check(CLI::IsMember({"little", "big"}));
+        cmd.add_option("--type", type, "Raw voxel type u8|u16|i16|f32")
+            ->check(CLI::IsMember({"u8", "u16", "i16", "f32"}));
+        cmd.add_option("--endian", endian, "Raw byte order little|big")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"little", "big"}));
         cmd.add_option("--spacing", spacing, "Voxel spacing sx,sy,sz (overrides the file's)")
             ->check(parsedBy(parseSpacing, "SX,SY,SZ"));
         cmd.add_option("--header-skip", headerSkip, "Raw bytes to skip before the voxels");
@@ -71,8 +74,8 @@ void parseClip(const std::string& c, VolumeRenderSettings& s) {
     char axis = 0;
     float lo = 0, hi = 0;
     char tail = 0;
-    if (std::sscanf(c.c_str(), "%c:%f:%f%c", &axis, &lo, &hi, &tail) != 3 || (axis != 'x' && axis != 'y' && axis != 'z') ||
-        !(lo >= 0 && hi <= 1 && lo < hi))
+    if (std::sscanf(c.c_str(), "%c:%f:%f%c", &axis, &lo, &hi, &tail) != 3 ||
+        (axis != 'x' && axis != 'y' && axis != 'z') || !(lo >= 0 && hi <= 1 && lo < hi))
         throw Error("--clip", "expected axis:lo:hi with axis x|y|z and 0 <= lo < hi <= 1, got '" + c + "'");
     const int a = axis - 'x';
     s.clipLo[a] = lo;
@@ -94,19 +97,28 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
     auto o = std::make_shared<Opts>();
     CLI::App* cmd = app.add_subcommand("volume", "Direct volume rendering of CT/MRI/OpenVDB volumes");
     o->common.addTo(*cmd, "volume.png");
-    cmd->add_option("FILE", o->file, "Volume: .raw .mhd/.mha .nrrd/.nhdr .nii[.gz] .vti .vdb or a DICOM directory")->required();
+    cmd->add_option("FILE", o->file, "Volume: .raw .mhd/.mha .nrrd/.nhdr .nii[.gz] .vti .vdb or a DICOM directory")
+        ->required();
     o->load.addTo(*cmd);
-    cmd->add_option("--tf", o->tf, "Transfer function: preset (ct-bone ct-skin ct-muscle mr-default grayscale viridis inferno cool-warm) or FILE.json");
-    cmd->add_option("--mode", o->mode, "dvr|shaded|mip|iso")->capture_default_str()->check(CLI::IsMember({"dvr", "shaded", "mip", "iso"}));
+    cmd->add_option("--tf", o->tf,
+                    "Transfer function: preset (ct-bone ct-skin ct-muscle mr-default grayscale viridis inferno "
+                    "cool-warm) or FILE.json");
+    cmd->add_option("--mode", o->mode, "dvr|shaded|mip|iso")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"dvr", "shaded", "mip", "iso"}));
     cmd->add_option("--iso", o->iso, "Isovalue in data units (iso mode)")->check(finiteNumber());
-    cmd->add_option("--step", o->step, "Ray-marching step in voxels")->capture_default_str()->check(finiteRange(0.01, 64.0));
+    cmd->add_option("--step", o->step, "Ray-marching step in voxels")
+        ->capture_default_str()
+        ->check(finiteRange(0.01, 64.0));
     cmd->add_option("--window", o->window, "Window width in data units (e.g. Hounsfield)")->check(positiveFinite());
     cmd->add_option("--level", o->level, "Window centre in data units")->check(finiteNumber());
     cmd->add_option("--clip", o->clips, "Clip axis:lo:hi (fractions, e.g. z:0:0.5); repeatable")
-        ->check(parsedBy([](const std::string& c) {
-            VolumeRenderSettings s;
-            parseClip(c, s);
-        }, "AXIS:LO:HI"));
+        ->check(parsedBy(
+            [](const std::string& c) {
+                VolumeRenderSettings s;
+                parseClip(c, s);
+            },
+            "AXIS:LO:HI"));
     cmd->add_flag("--no-skip", o->noSkip, "Disable empty-space skipping (for comparisons)");
     list.push_back({cmd, [o] {
                         CommonOptions& c = o->common;
@@ -128,7 +140,8 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                         auto t0 = std::chrono::steady_clock::now();
                         const VolumeLoadOptions lopt = o->load.options(!c.quiet);
                         BrickedVolume vol;
-                        const bool sparse = o->load.dims.empty() && o->file.size() > 4 && o->file.substr(o->file.size() - 4) == ".vdb";
+                        const bool sparse =
+                            o->load.dims.empty() && o->file.size() > 4 && o->file.substr(o->file.size() - 4) == ".vdb";
                         if (sparse) {
                             // bricked straight from the sparse tree
                             vol = loadBrickedVolume(o->file, lopt);
@@ -172,7 +185,8 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                         const uint64_t samples = gVolumeCounters.samples, skipped = gVolumeCounters.skipped;
                         stats.add("samples", (unsigned long long)samples);
                         stats.add("msamples_per_s", renderMs > 0 ? double(samples) / (renderMs * 1000.0) : 0.0);
-                        stats.add("skipped_fraction", samples + skipped ? double(skipped) / double(samples + skipped) : 0.0);
+                        stats.add("skipped_fraction",
+                                  samples + skipped ? double(skipped) / double(samples + skipped) : 0.0);
                         stats.add("tf", tf.name);
                         stats.add("window_lo", double(window.first));
                         stats.add("window_hi", double(window.second));
@@ -192,8 +206,12 @@ void addGenVolumeCommand(CLI::App& gen, CommandList& list) {
     cmd->add_option("KIND", o->kind, "phantom|slab")->required()->check(CLI::IsMember({"phantom", "slab"}));
     cmd->add_option("-o,--out", o->out, "Output .mhd (with a .raw next to it) or .raw")->required();
     cmd->add_option("--size", o->size, "Voxels per axis")->capture_default_str()->check(CLI::Range(2, 2048));
-    cmd->add_option("--type", o->type, "phantom voxel type u8|u16")->capture_default_str()->check(CLI::IsMember({"u8", "u16"}));
-    cmd->add_option("--thickness", o->thickness, "slab thickness along z in voxels")->capture_default_str()->check(CLI::Range(1, 2047));
+    cmd->add_option("--type", o->type, "phantom voxel type u8|u16")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"u8", "u16"}));
+    cmd->add_option("--thickness", o->thickness, "slab thickness along z in voxels")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 2047));
     cmd->add_flag("--quiet", o->quiet, "No progress output");
     list.push_back({cmd, [o] {
                         VolumeGrid g;
@@ -203,16 +221,21 @@ void addGenVolumeCommand(CLI::App& gen, CommandList& list) {
                             const int z0 = (o->size - 1 - o->thickness) / 2;
                             g = makeSlab(o->size, o->size, o->size, z0, z0 + o->thickness, 255);
                             if (!o->quiet)
-                                std::printf("slab: value 255 for z in [%d, %d] (%d voxels thick along z), 0 elsewhere; "
-                                            "a TF of opacity a per voxel gives transmittance (1-a)^%d along z\n",
-                                            z0, z0 + o->thickness, o->thickness, o->thickness);
+                                std::printf(
+                                    "slab: value 255 for z in [%d, %d] (%d voxels thick along z), 0 elsewhere; "
+                                    "a TF of opacity a per voxel gives transmittance (1-a)^%d along z\n",
+                                    z0, z0 + o->thickness, o->thickness, o->thickness);
                         }
                         const std::string ext = std::filesystem::path(o->out).extension().string();
-                        if (ext == ".mhd") writeMetaImage(o->out, g);
-                        else if (ext == ".raw") writeRaw(o->out, g);
-                        else throw Error(o->out, "output must end in .mhd or .raw");
+                        if (ext == ".mhd")
+                            writeMetaImage(o->out, g);
+                        else if (ext == ".raw")
+                            writeRaw(o->out, g);
+                        else
+                            throw Error(o->out, "output must end in .mhd or .raw");
                         if (!o->quiet)
-                            std::printf("wrote %s: %dx%dx%d %s\n", o->out.c_str(), g.dims[0], g.dims[1], g.dims[2], storageName(g.storage));
+                            std::printf("wrote %s: %dx%dx%d %s\n", o->out.c_str(), g.dims[0], g.dims[1], g.dims[2],
+                                        storageName(g.storage));
                         return 0;
                     }});
 }
@@ -223,16 +246,19 @@ std::optional<int> volumeInfo(const std::string& file) {
     lo.progress = false;
     const VolumeGrid g = loadVolume(file, lo);
     const VolumeSummary s = summarize(g, 8);
-    std::printf("file: %s\nkind: volume\ndims: %d x %d x %d\nvoxels: %zu\ntype: %s (stored as %s, value = stored * %g + %g)\n",
-                file.c_str(), g.dims[0], g.dims[1], g.dims[2], g.voxelCount(), g.sourceType.c_str(), storageName(g.storage),
-                double(g.scale), double(g.offset));
+    std::printf(
+        "file: %s\nkind: volume\ndims: %d x %d x %d\nvoxels: %zu\ntype: %s (stored as %s, value = stored * %g + %g)\n",
+        file.c_str(), g.dims[0], g.dims[1], g.dims[2], g.voxelCount(), g.sourceType.c_str(), storageName(g.storage),
+        double(g.scale), double(g.offset));
     std::printf("spacing: %g %g %g\norigin: %g %g %g\n", double(g.spacing.x), double(g.spacing.y), double(g.spacing.z),
                 double(g.origin.x), double(g.origin.y), double(g.origin.z));
     const AABB b = g.bounds();
-    std::printf("bounds: [%g %g %g] - [%g %g %g]\n", double(b.lo.x), double(b.lo.y), double(b.lo.z), double(b.hi.x), double(b.hi.y), double(b.hi.z));
-    std::printf("range: %g .. %g (mean %g)\nmemory_mb: %.2f\nhistogram (8 bins over the range, %% of voxels):", double(s.lo), double(s.hi),
-                s.mean, double(g.memoryBytes()) / 1048576.0);
-    for (uint64_t h : s.histogram) std::printf(" %.1f", 100.0 * double(h) / double(std::max<size_t>(g.voxelCount(), 1)));
+    std::printf("bounds: [%g %g %g] - [%g %g %g]\n", double(b.lo.x), double(b.lo.y), double(b.lo.z), double(b.hi.x),
+                double(b.hi.y), double(b.hi.z));
+    std::printf("range: %g .. %g (mean %g)\nmemory_mb: %.2f\nhistogram (8 bins over the range, %% of voxels):",
+                double(s.lo), double(s.hi), s.mean, double(g.memoryBytes()) / 1048576.0);
+    for (uint64_t h : s.histogram)
+        std::printf(" %.1f", 100.0 * double(h) / double(std::max<size_t>(g.voxelCount(), 1)));
     std::printf("\n");
     if (!g.meta.modality.empty())
         std::printf("modality: %s (%s)\n", g.meta.modality.c_str(), g.meta.modalitySource.c_str());

@@ -45,13 +45,15 @@ CLI::Validator numberValidator(std::function<std::string(double)> check, std::st
 CLI::Validator finiteRange(double lo, double hi) {
     const std::string range = shortNumber(lo) + " to " + shortNumber(hi);
     return numberValidator(
-        [lo, hi, range](double v) { return v < lo || v > hi ? "must be between " + range + ", got " + shortNumber(v) : std::string(); },
+        [lo, hi, range](double v) {
+            return v < lo || v > hi ? "must be between " + range + ", got " + shortNumber(v) : std::string();
+        },
         "NUMBER in [" + range + "]");
 }
 
 CLI::Validator positiveFinite() {
-    return numberValidator([](double v) { return v > 0 ? std::string() : "must be greater than 0, got " + shortNumber(v); },
-                           "POSITIVE");
+    return numberValidator(
+        [](double v) { return v > 0 ? std::string() : "must be greater than 0, got " + shortNumber(v); }, "POSITIVE");
 }
 
 CLI::Validator finiteNumber() {
@@ -81,7 +83,9 @@ Vec3f parseVec3(const std::string& text, const std::string& option) {
 
 std::pair<int, int> parseSize(const std::string& text) {
     const auto x = text.find_first_of("xX");
-    auto bad = [&] { return CLI::ValidationError("--size", "expected WxH with 1..16384 pixels each, got '" + text + "'"); };
+    auto bad = [&] {
+        return CLI::ValidationError("--size", "expected WxH with 1..16384 pixels each, got '" + text + "'");
+    };
     if (x == std::string::npos) throw bad();
     int w = 0, h = 0;
     try {
@@ -106,8 +110,12 @@ void CommonOptions::addTo(CLI::App& cmd, const std::string& defaultOut) {
     cmd.add_option("--eye", eye, "Camera position x,y,z (default: fitted to the scene)");
     cmd.add_option("--at", at, "Camera target x,y,z (default: scene centre)");
     cmd.add_option("--up", up, "Camera up vector x,y,z");
-    cmd.add_option("--fov", fov, "Vertical field of view in degrees")->capture_default_str()->check(finiteRange(1.0, 170.0));
-    cmd.add_option("--threads", threads, "Render threads (0: all cores)")->capture_default_str()->check(CLI::Range(0, 1024));
+    cmd.add_option("--fov", fov, "Vertical field of view in degrees")
+        ->capture_default_str()
+        ->check(finiteRange(1.0, 170.0));
+    cmd.add_option("--threads", threads, "Render threads (0: all cores)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1024));
     cmd.add_option("--packet", packet, "Rays per packet (" + supportedPacketSizes() + ")")->capture_default_str();
     cmd.add_option("--spp", spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 20));
     cmd.add_flag("--quiet", quiet, "No progress bars");
@@ -140,7 +148,8 @@ CameraFrame CommonOptions::frame(const AABB& bounds, Vec3f viewDir, Vec3f upDefa
     // An eye on its target or an up vector along the view leaves the camera without axes
     // (a NaN image): the user's options are errors, the default up is replaced.
     const Vec3f view = f.at - f.eye;
-    if (!(length(view) > 0.0f)) throw CLI::ValidationError("--eye", "coincides with the camera target (--at or the scene centre)");
+    if (!(length(view) > 0.0f))
+        throw CLI::ValidationError("--eye", "coincides with the camera target (--at or the scene centre)");
     auto alongView = [&](Vec3f u) { return !(length(cross(normalize(view), normalize(u))) > 1e-3f); };
     if (alongView(f.up)) {
         if (upV) throw CLI::ValidationError("--up", "is parallel to the viewing direction");

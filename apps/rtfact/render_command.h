@@ -15,12 +15,13 @@ namespace rtfact::app {
 
 // Returns the render statistics (render time excludes writing the image).
 template <class Integrator, class Scene>
-RenderStats renderToFile(const Scene& scene, const Integrator& integrator, const CommonOptions& o, const CameraFrame& frame,
-                  Stats& stats) {
+RenderStats renderToFile(const Scene& scene, const Integrator& integrator, const CommonOptions& o,
+                         const CameraFrame& frame, Stats& stats) {
     const PinholeCamera cam(frame, o.width, o.height);
     // Accumulation buffer, resolved copy and 8-bit output.
-    checkMemory(o.out, uint64_t(o.width) * uint64_t(o.height) * 36u, "a " + std::to_string(o.width) + "x" +
-                std::to_string(o.height) + " framebuffer", "use a smaller --size");
+    checkMemory(o.out, uint64_t(o.width) * uint64_t(o.height) * 36u,
+                "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " framebuffer",
+                "use a smaller --size");
     RGBAFramebuffer fb(o.width, o.height);
     const RayTracingRenderer<JitteredSampler, Integrator> renderer{{}, integrator};
     RenderOptions ro;

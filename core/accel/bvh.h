@@ -45,8 +45,7 @@ struct BVH : BVHTopology {
 };
 
 template <Primitive Elem, class B>
-    requires Builder<B, BVHTopology>
-BVH<Elem> buildBVH(const B& builder, std::span<const Elem> elems) {
+requires Builder<B, BVHTopology> BVH<Elem> buildBVH(const B& builder, std::span<const Elem> elems) {
     std::vector<AABB> bounds(elems.size());
     for (size_t i = 0; i < elems.size(); ++i) bounds[i] = elems[i].bounds();
     BVH<Elem> bvh;
@@ -85,8 +84,7 @@ inline float sahCost(const BVHTopology& t, float ct = 1.0f, float ci = 1.0f) {
     const float rootArea = t.nodes[0].box().surfaceArea();
     if (rootArea <= 0.0f) return 0.0f;
     double cost = 0;
-    for (const BVHNode& n : t.nodes)
-        cost += double(n.box().surfaceArea()) * (n.isLeaf() ? ci * n.count() : ct);
+    for (const BVHNode& n : t.nodes) cost += double(n.box().surfaceArea()) * (n.isLeaf() ? ci * n.count() : ct);
     return float(cost / rootArea);
 }
 

@@ -4,10 +4,10 @@
 // culled with an interval-arithmetic frustum test, and any-hit queries stop as soon
 // as every lane has found an occluder.
 #pragma once
-#include "core/util/assert.h"
 #include "core/accel/bvh.h"
 #include "core/accel/ray_box.h"
 #include "core/concepts/intersector.h"
+#include "core/util/assert.h"
 
 namespace rtfact {
 

@@ -4,16 +4,16 @@
 // binning and one partition sweep over contiguous memory. Subtrees are built in
 // parallel with TBB. Works on bounds only, like every builder.
 #pragma once
+#include <immintrin.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstring>
-#include <immintrin.h>
 #include <limits>
 #include <span>
 #include <vector>
-
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #include "core/accel/bvh.h"
 #include "core/simd/native.h"
@@ -79,7 +79,8 @@ struct InPlaceSAHBVHBuilder {
         Box4 box, cbox;
         for (uint32_t i = 0; i < n; ++i) {
             Ref& r = refs[i];
-            r = {{bounds[i].lo.x, bounds[i].lo.y, bounds[i].lo.z, 0.0f}, {bounds[i].hi.x, bounds[i].hi.y, bounds[i].hi.z, 0.0f}};
+            r = {{bounds[i].lo.x, bounds[i].lo.y, bounds[i].lo.z, 0.0f},
+                 {bounds[i].hi.x, bounds[i].hi.y, bounds[i].hi.z, 0.0f}};
             std::memcpy(&r.lo[3], &i, 4);
             box.extend(lo4(r), hi4(r));
             const __m128 c = c2(r);
@@ -136,7 +137,8 @@ struct InPlaceSAHBVHBuilder {
             for (uint32_t i = b; i < e; ++i) {
                 const Ref& r = ctx.refs[i];
                 const __m128 l = lo4(r), h = hi4(r);
-                const __m128i k = _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_add_ps(l, h), cmin), sc)), maxBin);
+                const __m128i k =
+                    _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_add_ps(l, h), cmin), sc)), maxBin);
                 alignas(16) int32_t ki[4];
                 _mm_store_si128(reinterpret_cast<__m128i*>(ki), k);
                 for (int a = 0; a < 3; ++a) {
@@ -182,7 +184,9 @@ struct InPlaceSAHBVHBuilder {
         uint32_t mid;
         if (axis >= 0) {
             const float s = scale[axis], lo = cb.lo[axis];
-            auto left = [&](const Ref& r) { return std::min(int((r.lo[axis] + r.hi[axis] - lo) * s), kBins - 1) <= split; };
+            auto left = [&](const Ref& r) {
+                return std::min(int((r.lo[axis] + r.hi[axis] - lo) * s), kBins - 1) <= split;
+            };
             uint32_t i = b, j = e;
             while (true) {
                 while (i < j && left(ctx.refs[i])) {
@@ -223,7 +227,8 @@ struct InPlaceSAHBVHBuilder {
         ctx.nodes[ni] = {a.lo, int32_t(left), a.hi, -(axis >= 0 ? axis : 0)};
         auto buildLeft = [&] { buildNode(ctx, left, b, mid, lbox, lcbox, depth + 1); };
         auto buildRight = [&] { buildNode(ctx, left + 1, mid, e, rbox, rcbox, depth + 1); };
-        if (n >= kParallelThreshold) tbb::parallel_invoke(buildLeft, buildRight);
+        if (n >= kParallelThreshold)
+            tbb::parallel_invoke(buildLeft, buildRight);
         else {
             buildLeft();
             buildRight();

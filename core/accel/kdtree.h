@@ -56,8 +56,7 @@ struct KdTree : KdTopology {
 };
 
 template <Primitive Elem, class B>
-    requires Builder<B, KdTopology>
-KdTree<Elem> buildKdTree(const B& builder, std::span<const Elem> elems) {
+requires Builder<B, KdTopology> KdTree<Elem> buildKdTree(const B& builder, std::span<const Elem> elems) {
     std::vector<AABB> bounds(elems.size());
     for (size_t i = 0; i < elems.size(); ++i) bounds[i] = elems[i].bounds();
     KdTree<Elem> tree;

@@ -12,10 +12,10 @@
 #pragma once
 #include <new>
 
-#include "core/util/assert.h"
 #include "core/accel/kdtree.h"
 #include "core/accel/ray_box.h"
 #include "core/concepts/intersector.h"
+#include "core/util/assert.h"
 
 namespace rtfact {
 

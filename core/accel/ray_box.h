@@ -9,8 +9,7 @@ namespace rtfact {
 // Entry/exit distances of chunk k against [lo, hi], clipped to [tMin, tFar].
 template <bool CommonOrigin, int N>
 RTFACT_INLINE Mask<Packet<N>::W> chunkHitsBox(const Vec3f& lo, const Vec3f& hi, const RayPacket<N>& rays,
-                                              const Packet<N>& tFar, int k,
-                                              Packet<Packet<N>::W>* entryOut = nullptr) {
+                                              const Packet<N>& tFar, int k, Packet<Packet<N>::W>* entryOut = nullptr) {
     using P = Packet<Packet<N>::W>;
     P tn[3], tf[3];
     for (int a = 0; a < 3; ++a) {

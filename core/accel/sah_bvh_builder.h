@@ -1,14 +1,14 @@
 // Binned SAH BVH builder (works on bounds only). Large ranges are binned and split in
 // parallel with TBB; node pairs are allocated atomically and reordered depth first.
 #pragma once
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <atomic>
 #include <span>
 #include <vector>
-
-#include <tbb/parallel_invoke.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/blocked_range.h>
 
 #include "core/accel/bvh.h"
 
@@ -165,8 +165,9 @@ struct SAHBVHBuilder {
             if (n <= uint32_t(maxLeafSize)) return makeLeaf(ctx, ni, r);
             bestAxis = r.cbox.maxAxis();
             mid = r.begin + n / 2;
-            std::nth_element(ctx.order.begin() + r.begin, ctx.order.begin() + mid, ctx.order.begin() + r.end,
-                             [&](uint32_t x, uint32_t y) { return ctx.centroids[x][bestAxis] < ctx.centroids[y][bestAxis]; });
+            std::nth_element(
+                ctx.order.begin() + r.begin, ctx.order.begin() + mid, ctx.order.begin() + r.end,
+                [&](uint32_t x, uint32_t y) { return ctx.centroids[x][bestAxis] < ctx.centroids[y][bestAxis]; });
         }
         const uint32_t left = ctx.nextNode.fetch_add(2);
         BVHNode& node = ctx.nodes[ni];
@@ -176,7 +177,8 @@ struct SAHBVHBuilder {
         node.meta = -bestAxis;
         auto buildLeft = [&] { buildNode(ctx, left, rangeBounds(ctx, r.begin, mid), depth + 1); };
         auto buildRight = [&] { buildNode(ctx, left + 1, rangeBounds(ctx, mid, r.end), depth + 1); };
-        if (n >= 4096) tbb::parallel_invoke(buildLeft, buildRight);
+        if (n >= 4096)
+            tbb::parallel_invoke(buildLeft, buildRight);
         else {
             buildLeft();
             buildRight();

@@ -2,13 +2,13 @@
 // (the element bound faces) are swept in sorted order, O(n log^2 n) overall; the two
 // subtrees of large nodes are built in parallel, then flattened depth first.
 #pragma once
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <span>
 #include <vector>
-
-#include <tbb/parallel_invoke.h>
 
 #include "core/accel/kdtree.h"
 
@@ -97,8 +97,8 @@ struct SAHKdTreeBuilder {
                 const float wl = p - box.lo[a], wr = box.hi[a] - p;
                 const float areaL = 2.0f * (ext[b] * ext[c] + wl * (ext[b] + ext[c]));
                 const float areaR = 2.0f * (ext[b] * ext[c] + wr * (ext[b] + ext[c]));
-                float cost = traversalCost + intersectionCost * invArea *
-                                                 (areaL * float(leftCount) + areaR * float(rightCount));
+                float cost =
+                    traversalCost + intersectionCost * invArea * (areaL * float(leftCount) + areaR * float(rightCount));
                 if (leftCount == 0 || rightCount == 0) cost *= (1.0f - emptyBonus);
                 if (cost < bestCost) {
                     bestCost = cost;
@@ -127,7 +127,8 @@ struct SAHKdTreeBuilder {
         t->split = bestSplit;
         auto bl = [&] { t->child[0] = buildNode(bounds, std::move(left), lbox, depth - 1); };
         auto br = [&] { t->child[1] = buildNode(bounds, std::move(right), rbox, depth - 1); };
-        if (n >= 2048) tbb::parallel_invoke(bl, br);
+        if (n >= 2048)
+            tbb::parallel_invoke(bl, br);
         else {
             bl();
             br();

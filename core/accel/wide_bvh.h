@@ -138,8 +138,7 @@ WideBVH<Elem, K> collapseBVH(const BVH<Elem>& bvh) {
 
 // Builds the binary BVH with `builder` and collapses it.
 template <Primitive Elem, int K = 8, class B>
-    requires Builder<B, BVHTopology>
-WideBVH<Elem, K> buildWideBVH(const B& builder, std::span<const Elem> elems) {
+requires Builder<B, BVHTopology> WideBVH<Elem, K> buildWideBVH(const B& builder, std::span<const Elem> elems) {
     return collapseBVH<K>(buildBVH<Elem>(builder, elems));
 }
 

@@ -9,9 +9,9 @@
 #include <cstring>
 #include <type_traits>
 
-#include "core/util/assert.h"
 #include "core/accel/wide_bvh.h"
 #include "core/concepts/intersector.h"
+#include "core/util/assert.h"
 
 namespace rtfact {
 
@@ -62,7 +62,6 @@ struct WideBVHIntersector {
     }
 
    private:
-
     // Copies every field of a single-ray hit into lane i of a packet hit. Hit records
     // are structs of 4-byte packets (t, id, u, v, ...), so Hit<N> is Hit<1> with every
     // field widened to N lanes.

@@ -11,8 +11,8 @@ struct RayCone {
 };
 
 template <class C>
-concept Camera = requires(const C& cam, const Packet<1>& x1, const Packet<simd::kNativeWidth>& xn,
-                          RayPacket<1>& r1, RayPacket<simd::kNativeWidth>& rn) {
+concept Camera = requires(const C& cam, const Packet<1>& x1, const Packet<simd::kNativeWidth>& xn, RayPacket<1>& r1,
+                          RayPacket<simd::kNativeWidth>& rn) {
     cam.template generate<1>(x1, x1, r1);
     cam.template generate<simd::kNativeWidth>(xn, xn, rn);
     { cam.cone() } -> std::convertible_to<RayCone>;

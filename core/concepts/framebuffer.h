@@ -8,8 +8,8 @@ namespace rtfact {
 
 template <class F>
 concept Framebuffer = requires(F& fb, const Radiance<1>& r1, const Radiance<simd::kNativeWidth>& rn,
-                               const PixelSample<1>& s1, const PixelSample<simd::kNativeWidth>& sn,
-                               const Mask<1>& m1, const Mask<simd::kNativeWidth>& mn) {
+                               const PixelSample<1>& s1, const PixelSample<simd::kNativeWidth>& sn, const Mask<1>& m1,
+                               const Mask<simd::kNativeWidth>& mn) {
     { fb.width() } -> std::convertible_to<int>;
     { fb.height() } -> std::convertible_to<int>;
     fb.template write<1>(s1, r1, m1);

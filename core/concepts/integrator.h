@@ -20,9 +20,8 @@ struct Radiance {
 };
 
 template <class I, class Scene>
-concept Integrator = requires(const I& integ, const Scene& scene, RayPacket<1>& r1,
-                              RayPacket<simd::kNativeWidth>& rn, const Mask<1>& m1,
-                              const Mask<simd::kNativeWidth>& mn, const PixelSample<1>& s1,
+concept Integrator = requires(const I& integ, const Scene& scene, RayPacket<1>& r1, RayPacket<simd::kNativeWidth>& rn,
+                              const Mask<1>& m1, const Mask<simd::kNativeWidth>& mn, const PixelSample<1>& s1,
                               const PixelSample<simd::kNativeWidth>& sn) {
     { integ.template eval<1>(scene, r1, m1, s1) } -> std::same_as<Radiance<1>>;
     { integ.template eval<simd::kNativeWidth>(scene, rn, mn, sn) } -> std::same_as<Radiance<simd::kNativeWidth>>;

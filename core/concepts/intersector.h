@@ -29,8 +29,8 @@ concept ElementIntersectorAt = requires(const I& isect, const E& e, uint32_t id,
 };
 
 template <class I, class E>
-concept ElementIntersector = Primitive<E> && ElementIntersectorAt<I, E, 1> &&
-                             ElementIntersectorAt<I, E, simd::kNativeWidth>;
+concept ElementIntersector =
+    Primitive<E> && ElementIntersectorAt<I, E, 1> && ElementIntersectorAt<I, E, simd::kNativeWidth>;
 
 template <class I, class A, int N>
 concept IntersectorAt = requires(const I& isect, const A& accel, const RayPacket<N>& rays,

@@ -7,19 +7,19 @@ namespace rtfact {
 
 template <int N>
 struct SurfacePoint {
-    Vec3<N> p;      // position
-    Vec3<N> n;      // shading normal, facing the incoming ray
-    Vec3<N> ng;     // geometric normal, facing the incoming ray
-    Packet<N> u, v; // surface parameterisation
-    Vec3<N> color;  // per-element colour (vertex/point colour), white when none
+    Vec3<N> p;       // position
+    Vec3<N> n;       // shading normal, facing the incoming ray
+    Vec3<N> ng;      // geometric normal, facing the incoming ray
+    Packet<N> u, v;  // surface parameterisation
+    Vec3<N> color;   // per-element colour (vertex/point colour), white when none
     Packet<N, int32_t> material;
 };
 
 template <int N>
 struct BsdfSample {
     Vec3<N> wi;
-    Vec3<N> weight;   // f * cos / pdf
-    Mask<N> specular; // delta lobes: no light sampling
+    Vec3<N> weight;    // f * cos / pdf
+    Mask<N> specular;  // delta lobes: no light sampling
     Mask<N> valid;
 };
 

@@ -12,8 +12,8 @@ struct Region {
 };
 
 template <class R, class Scene, class Cam, class FB>
-concept Renderer = Camera<Cam> && Framebuffer<FB> && requires(const R& r, const Scene& s, const Cam& c, FB& fb,
-                                                              Region region) {
+concept Renderer = Camera<Cam> && Framebuffer<FB> &&
+    requires(const R& r, const Scene& s, const Cam& c, FB& fb, Region region) {
     r.template render<1>(s, c, fb, region, 0);
     r.template render<simd::kNativeWidth>(s, c, fb, region, 0);
 };

@@ -100,8 +100,8 @@ static_assert(Intersector<BVHIntersector<SphereIntersector>, BVH<Sphere>>);
 static_assert(Intersector<KdTreeIntersector<SphereIntersector>, KdTree<Sphere>>);
 static_assert(Integrator<EyeLightIntegrator, SphereScene>);
 static_assert(Integrator<DirectLightIntegrator, SphereScene>);
-static_assert(Renderer<RayTracingRenderer<PixelCenterSampler, EyeLightIntegrator>, SphereScene, PinholeCamera,
-                       RGBAFramebuffer>);
-static_assert(Renderer<RayTracingRenderer<JitteredSampler, DirectLightIntegrator>, SphereScene, PinholeCamera,
-                       RGBAFramebuffer>);
+static_assert(
+    Renderer<RayTracingRenderer<PixelCenterSampler, EyeLightIntegrator>, SphereScene, PinholeCamera, RGBAFramebuffer>);
+static_assert(
+    Renderer<RayTracingRenderer<JitteredSampler, DirectLightIntegrator>, SphereScene, PinholeCamera, RGBAFramebuffer>);
 }  // namespace rtfact

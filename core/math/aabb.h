@@ -34,8 +34,8 @@ struct AABB {
         return d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
     }
     bool contains(const AABB& b, float eps = 0.0f) const {
-        return b.lo.x >= lo.x - eps && b.lo.y >= lo.y - eps && b.lo.z >= lo.z - eps &&
-               b.hi.x <= hi.x + eps && b.hi.y <= hi.y + eps && b.hi.z <= hi.z + eps;
+        return b.lo.x >= lo.x - eps && b.lo.y >= lo.y - eps && b.lo.z >= lo.z - eps && b.hi.x <= hi.x + eps &&
+               b.hi.y <= hi.y + eps && b.hi.z <= hi.z + eps;
     }
     bool contains(Vec3f p) const {
         return p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z;

@@ -8,8 +8,8 @@
 #pragma once
 #include <cmath>
 
-#include "core/render/random.h"
 #include "core/render/primary_hit.h"
+#include "core/render/random.h"
 #include "core/render/sampling.h"
 #include "core/render/secondary_rays.h"
 

@@ -2,8 +2,8 @@
 // the scene's lights plus a small ambient term. All shadow rays of a packet towards
 // one light travel together as a packet.
 #pragma once
-#include "core/render/primary_hit.h"
 #include "core/render/light_list.h"
+#include "core/render/primary_hit.h"
 
 namespace rtfact {
 

@@ -1,6 +1,7 @@
 // Directional light (sun): constant radiance from one direction.
 #pragma once
 #include "core/concepts/light.h"
+#include "core/ray/ray_packet.h"  // kInfinity
 
 namespace rtfact {
 

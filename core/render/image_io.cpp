@@ -1,9 +1,9 @@
 #include "core/render/image_io.h"
 
+#include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -144,15 +144,17 @@ Image readImage(const std::string& path) {
     if (!in) throw Error(path, "cannot read image: " + oneLine(OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.nchannels > 64 || spec.depth > 1)
-        throw Error(path, "unsupported image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +
-                              std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) + " channels");
+        throw Error(path, "unsupported image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                              "x" + std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) +
+                              " channels");
     // A lying header must not make us allocate: no format we read compresses better than
     // deflate's 1032:1, so 4096 decoded bytes per file byte is a generous bound.
     const uint64_t decoded = uint64_t(spec.width) * uint64_t(spec.height) * uint64_t(spec.nchannels);
     if (decoded * spec.format.size() / 4096 > fileBytes)
         throw Error(path, "image header claims " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
                               " pixels, more than a file of " + std::to_string(fileBytes) + " bytes can hold");
-    checkMemory(path, decoded * sizeof(float), "a " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " image",
+    checkMemory(path, decoded * sizeof(float),
+                "a " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " image",
                 "use a smaller texture");
     Image img;
     img.width = spec.width;

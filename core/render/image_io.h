@@ -10,7 +10,9 @@ namespace rtfact {
 struct Image {
     int width = 0, height = 0, channels = 0;
     std::vector<float> pixels;  // linear values, channels interleaved
-    float at(int x, int y, int c) const { return pixels[(size_t(y) * size_t(width) + size_t(x)) * size_t(channels) + size_t(c)]; }
+    float at(int x, int y, int c) const {
+        return pixels[(size_t(y) * size_t(width) + size_t(x)) * size_t(channels) + size_t(c)];
+    }
 };
 
 // Throws rtfact::Error when `path` has no supported extension or its directory is not

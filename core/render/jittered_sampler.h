@@ -9,8 +9,8 @@ namespace rtfact {
 
 struct JitteredSampler {
     template <int N>
-    RTFACT_INLINE void offsets(const Packet<N, int32_t>& px, const Packet<N, int32_t>& py, int sample,
-                               Packet<N>& ox, Packet<N>& oy) const {
+    RTFACT_INLINE void offsets(const Packet<N, int32_t>& px, const Packet<N, int32_t>& py, int sample, Packet<N>& ox,
+                               Packet<N>& oy) const {
         if (sample == 0) {
             ox = Packet<N>(0.5f);
             oy = Packet<N>(0.5f);

@@ -1,12 +1,12 @@
 // Renders a whole image with a renderer: the image plane is split into tiles that TBB
 // hands to worker threads dynamically (work stealing), for any number of samples.
 #pragma once
-#include <atomic>
-#include <chrono>
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include <atomic>
+#include <chrono>
 
 #include "core/render/ray_stats.h"
 #include "core/util/progress.h"
@@ -14,7 +14,7 @@
 namespace rtfact {
 
 struct RenderOptions {
-    int threads = 0;     // 0: all cores
+    int threads = 0;  // 0: all cores
     int tileSize = 32;
     int spp = 1;
     bool progress = true;
@@ -27,9 +27,7 @@ struct RenderStats {
     int threads = 0;
 };
 
-inline int resolveThreads(int requested) {
-    return requested > 0 ? requested : tbb::this_task_arena::max_concurrency();
-}
+inline int resolveThreads(int requested) { return requested > 0 ? requested : tbb::this_task_arena::max_concurrency(); }
 
 template <int N, class R, class Scene, class Cam, class FB>
 RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam, FB& fb, const RenderOptions& opt) {

@@ -17,8 +17,10 @@ struct Tracer {
     Hit<N> intersect(const Accel& accel, const RayPacket<N>& rays, const Mask<N>& active) const {
         tlsRaysTraced += uint64_t(popcount(active));
         Hit<N> hit;
-        if (rays.commonOrigin) isect.template intersect<true, D>(accel, rays, hit, active);
-        else isect.template intersect<false, D>(accel, rays, hit, active);
+        if (rays.commonOrigin)
+            isect.template intersect<true, D>(accel, rays, hit, active);
+        else
+            isect.template intersect<false, D>(accel, rays, hit, active);
         return hit;
     }
     template <class Accel, int N>

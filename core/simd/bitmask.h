@@ -14,8 +14,7 @@ struct BitMask {
     BitMask() = default;
     explicit BitMask(const Mask<N>& m) {
         constexpr int W = Mask<N>::W;
-        for (int k = 0; k < Mask<N>::C; ++k)
-            w[(k * W) / 64] |= uint64_t(movemask<W>(m.c[k])) << ((k * W) % 64);
+        for (int k = 0; k < Mask<N>::C; ++k) w[(k * W) / 64] |= uint64_t(movemask<W>(m.c[k])) << ((k * W) % 64);
     }
     bool operator[](int i) const { return (w[i >> 6] >> (i & 63)) & 1; }
     void set(int i) { w[i >> 6] |= uint64_t(1) << (i & 63); }

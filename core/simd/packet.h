@@ -64,15 +64,15 @@ struct __attribute__((may_alias)) Packet {
     // Single-lane packets read as the scalar they hold.
     RTFACT_INLINE operator T() const requires(N == 1) { return c[0]; }
 
-#define RTFACT_PACKET_BINOP(op)                                                         \
-    friend RTFACT_INLINE Packet operator op(const Packet& a, const Packet& b) {          \
-        Packet r;                                                                        \
-        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] op b.c[i];                           \
-        return r;                                                                        \
-    }                                                                                    \
-    RTFACT_INLINE Packet& operator op##=(const Packet& b) {                              \
-        for (int i = 0; i < C; ++i) c[i] = c[i] op b.c[i];                               \
-        return *this;                                                                    \
+#define RTFACT_PACKET_BINOP(op)                                                 \
+    friend RTFACT_INLINE Packet operator op(const Packet& a, const Packet& b) { \
+        Packet r;                                                               \
+        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] op b.c[i];                  \
+        return r;                                                               \
+    }                                                                           \
+    RTFACT_INLINE Packet& operator op##=(const Packet& b) {                     \
+        for (int i = 0; i < C; ++i) c[i] = c[i] op b.c[i];                      \
+        return *this;                                                           \
     }
     RTFACT_PACKET_BINOP(+)
     RTFACT_PACKET_BINOP(-)
@@ -95,11 +95,11 @@ struct __attribute__((may_alias)) Packet {
         return r;
     }
 
-#define RTFACT_PACKET_CMP(op, fn)                                                       \
-    friend RTFACT_INLINE Mask<N> operator op(const Packet& a, const Packet& b) {         \
-        Mask<N> r;                                                                       \
-        for (int i = 0; i < C; ++i) r.c[i] = fn<W>(a.c[i], b.c[i]);                      \
-        return r;                                                                        \
+#define RTFACT_PACKET_CMP(op, fn)                                                \
+    friend RTFACT_INLINE Mask<N> operator op(const Packet& a, const Packet& b) { \
+        Mask<N> r;                                                               \
+        for (int i = 0; i < C; ++i) r.c[i] = fn<W>(a.c[i], b.c[i]);              \
+        return r;                                                                \
     }
     RTFACT_PACKET_CMP(<, cmpLt)
     RTFACT_PACKET_CMP(<=, cmpLe)
@@ -171,12 +171,12 @@ RTFACT_INLINE Mask<N> select(const Mask<N>& m, const Mask<N>& a, const Mask<N>& 
     return (m & a) | andNot(b, m);
 }
 
-#define RTFACT_PACKET_UNARY(name, fn)                                              \
-    template <int N>                                                                \
-    RTFACT_INLINE Packet<N> name(const Packet<N>& a) {                              \
-        Packet<N> r;                                                                \
-        for (int i = 0; i < Packet<N>::C; ++i) r.c[i] = fn<Packet<N>::W>(a.c[i]);   \
-        return r;                                                                   \
+#define RTFACT_PACKET_UNARY(name, fn)                                             \
+    template <int N>                                                              \
+    RTFACT_INLINE Packet<N> name(const Packet<N>& a) {                            \
+        Packet<N> r;                                                              \
+        for (int i = 0; i < Packet<N>::C; ++i) r.c[i] = fn<Packet<N>::W>(a.c[i]); \
+        return r;                                                                 \
     }
 RTFACT_PACKET_UNARY(sqrt, vsqrt)
 RTFACT_PACKET_UNARY(rcp, vrcp)
@@ -253,7 +253,9 @@ RTFACT_INLINE bool all(const Mask<N>& m) {
     return movemask<Mask<N>::W>(a) == full;
 }
 template <int N>
-RTFACT_INLINE bool none(const Mask<N>& m) { return !any(m); }
+RTFACT_INLINE bool none(const Mask<N>& m) {
+    return !any(m);
+}
 template <int N>
 RTFACT_INLINE int popcount(const Mask<N>& m) {
     int n = 0;

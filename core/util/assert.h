@@ -8,12 +8,12 @@
 #include <cstdio>
 #include <cstdlib>
 #define RTFACT_ASSERTS_ON 1
-#define RTFACT_ASSERT(cond, message)                                                                         \
-    do {                                                                                                     \
-        if (!(cond)) [[unlikely]] {                                                                          \
+#define RTFACT_ASSERT(cond, message)                                                                           \
+    do {                                                                                                       \
+        if (!(cond)) [[unlikely]] {                                                                            \
             std::fprintf(stderr, "%s:%d: RTFACT_ASSERT(%s) failed: %s\n", __FILE__, __LINE__, #cond, message); \
-            std::abort();                                                                                    \
-        }                                                                                                    \
+            std::abort();                                                                                      \
+        }                                                                                                      \
     } while (0)
 #else
 #define RTFACT_ASSERTS_ON 0

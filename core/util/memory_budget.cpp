@@ -35,11 +35,28 @@ uint64_t readUserLimit() {
     const double v = std::strtod(env, &end);
     double scale = 1;
     switch (*end) {
-        case 'k': case 'K': scale = 1024.0; ++end; break;
-        case 'm': case 'M': scale = 1024.0 * 1024.0; ++end; break;
-        case 'g': case 'G': scale = 1024.0 * 1024.0 * 1024.0; ++end; break;
-        case 't': case 'T': scale = 1024.0 * 1024.0 * 1024.0 * 1024.0; ++end; break;
-        default: break;
+        case 'k':
+        case 'K':
+            scale = 1024.0;
+            ++end;
+            break;
+        case 'm':
+        case 'M':
+            scale = 1024.0 * 1024.0;
+            ++end;
+            break;
+        case 'g':
+        case 'G':
+            scale = 1024.0 * 1024.0 * 1024.0;
+            ++end;
+            break;
+        case 't':
+        case 'T':
+            scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+            ++end;
+            break;
+        default:
+            break;
     }
     if (*end == 'i' || *end == 'B') ++end;  // accept 2GiB / 2GB
     if (*end == 'B') ++end;
@@ -69,9 +86,12 @@ uint64_t availableMemoryBytes() {
 std::string formatBytes(uint64_t bytes) {
     char buf[64];
     const double b = double(bytes);
-    if (b >= 1024.0 * 1024.0 * 1024.0) std::snprintf(buf, sizeof buf, "%.1f GiB", b / (1024.0 * 1024.0 * 1024.0));
-    else if (b >= 1024.0 * 1024.0) std::snprintf(buf, sizeof buf, "%.1f MiB", b / (1024.0 * 1024.0));
-    else std::snprintf(buf, sizeof buf, "%.0f KiB", b / 1024.0);
+    if (b >= 1024.0 * 1024.0 * 1024.0)
+        std::snprintf(buf, sizeof buf, "%.1f GiB", b / (1024.0 * 1024.0 * 1024.0));
+    else if (b >= 1024.0 * 1024.0)
+        std::snprintf(buf, sizeof buf, "%.1f MiB", b / (1024.0 * 1024.0));
+    else
+        std::snprintf(buf, sizeof buf, "%.0f KiB", b / 1024.0);
     return buf;
 }
 
@@ -79,8 +99,8 @@ void checkMemory(const std::string& file, uint64_t bytes, const std::string& wha
     const uint64_t avail = availableMemoryBytes();
     // Leave a tenth of what is free for everything else.
     if (avail != UINT64_MAX && bytes > avail - avail / 10) {
-        std::string msg = "needs " + formatBytes(bytes) + " for " + what + " but only " + formatBytes(avail) +
-                          " are available";
+        std::string msg =
+            "needs " + formatBytes(bytes) + " for " + what + " but only " + formatBytes(avail) + " are available";
         if (!hint.empty()) msg += " (" + hint + ")";
         throw Error(file, msg);
     }

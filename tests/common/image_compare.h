@@ -82,7 +82,8 @@ inline void expectMatchesReference(const std::string& referencePath, int w, int 
     ASSERT_EQ(ref.height, h);
     std::vector<float> refRGBA(size_t(w) * size_t(h) * 4, 1.0f);
     for (size_t p = 0; p < size_t(w) * size_t(h); ++p)
-        for (int c = 0; c < 3; ++c) refRGBA[p * 4 + size_t(c)] = ref.pixels[p * size_t(ref.channels) + size_t(std::min(c, ref.channels - 1))];
+        for (int c = 0; c < 3; ++c)
+            refRGBA[p * 4 + size_t(c)] = ref.pixels[p * size_t(ref.channels) + size_t(std::min(c, ref.channels - 1))];
     const ImageDiff d = compareRGBA(rgba, refRGBA, w, h, tol.channelTolerance);
     const bool ok = d.differentFraction <= tol.maxDifferentFraction && d.psnr >= tol.minPsnr;
     if (!ok) {
@@ -95,9 +96,9 @@ inline void expectMatchesReference(const std::string& referencePath, int w, int 
         writeImage(stem + ".diff.png", w, h, diff);
     }
     EXPECT_TRUE(ok) << referencePath << ": " << d.differentFraction * 100.0 << "% pixels differ by more than "
-                    << tol.channelTolerance << "/255 (allowed " << tol.maxDifferentFraction * 100.0
-                    << "%), PSNR " << d.psnr << " dB (min " << tol.minPsnr << "), max channel diff "
-                    << d.maxChannelDiff << "; images written to " << testOutDir();
+                    << tol.channelTolerance << "/255 (allowed " << tol.maxDifferentFraction * 100.0 << "%), PSNR "
+                    << d.psnr << " dB (min " << tol.minPsnr << "), max channel diff " << d.maxChannelDiff
+                    << "; images written to " << testOutDir();
 }
 
 }  // namespace rtfact::test

@@ -30,8 +30,8 @@ void check() {
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     int hits = 0, misses = 0, culled = 0;
     for (int iter = 0; iter < 400; ++iter) {
-        const Vec3f c{u(rng) * 3, u(rng) * 3, u(rng) * 3}, e{std::fabs(u(rng)) + 0.05f, std::fabs(u(rng)) + 0.05f,
-                                                            std::fabs(u(rng)) + 0.05f};
+        const Vec3f c{u(rng) * 3, u(rng) * 3, u(rng) * 3},
+            e{std::fabs(u(rng)) + 0.05f, std::fabs(u(rng)) + 0.05f, std::fabs(u(rng)) + 0.05f};
         const Vec3f lo = c - e, hi = c + e;
         RayPacket<N> r;
         const Vec3f o0{u(rng) * 8, u(rng) * 8, 10.0f};

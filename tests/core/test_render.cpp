@@ -184,7 +184,7 @@ TEST(Render, ProgressiveSamplesAverage) {
     const auto one = render<16>(EyeLightIntegrator{}, 0, 1);
     const auto four = render<16>(EyeLightIntegrator{}, 0, 4);
     const auto d = test::compareRGBA(one, four, kW, kH, 8);
-    EXPECT_GT(d.psnr, 20.0);                 // the same picture...
+    EXPECT_GT(d.psnr, 20.0);                // the same picture...
     EXPECT_GT(d.differentFraction, 0.001);  // ...but antialiased edges
 }
 

@@ -37,7 +37,7 @@ void checkOps() {
         const Packet<N> sum = a + b, dif = a - b, prod = a * b, quo = a / pos;
         const Packet<N> mn = min(a, b), mx = max(a, b), sel = select(m, a, b);
         const Packet<N> sq = sqrt(pos), rc = rcp(pos), fl = floor(a), ab = abs(a);
-        const Mask<N> lt = a < b, le = a <= b, gt = a > b, eq = a == a, ne = a != b;
+        const Mask<N> lt = a<b, le = a <= b, gt = a> b, eq = a == a, ne = a != b;
         const Packet<N, int32_t> ai = toInt(a);
         const Packet<N> af = toFloat(ai);
         for (int i = 0; i < N; ++i) {

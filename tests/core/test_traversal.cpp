@@ -61,8 +61,10 @@ void checkAgainstBruteForce(const Accel& accel, const Isect& isect, const std::v
         for (int i = 0; i < N; ++i)
             if ((iter + i) % 7 == 3) active.set(i, false);
         typename Isect::template Hit<N> hit;
-        if (co) isect.template intersect<true, HitData::Shading>(accel, rays, hit, active);
-        else isect.template intersect<false, HitData::Shading>(accel, rays, hit, active);
+        if (co)
+            isect.template intersect<true, HitData::Shading>(accel, rays, hit, active);
+        else
+            isect.template intersect<false, HitData::Shading>(accel, rays, hit, active);
         const Mask<N> occ = co ? isect.template occluded<true>(accel, rays, active)
                                : isect.template occluded<false>(accel, rays, active);
         for (int i = 0; i < N; ++i) {

@@ -33,8 +33,10 @@ class ScopedEnv {
         if (const char* v = std::getenv(name)) old_ = v;
     }
     ~ScopedEnv() {
-        if (old_) ::setenv(name_, old_->c_str(), 1);
-        else ::unsetenv(name_);
+        if (old_)
+            ::setenv(name_, old_->c_str(), 1);
+        else
+            ::unsetenv(name_);
     }
     void set(const char* value) const { ::setenv(name_, value, 1); }
 

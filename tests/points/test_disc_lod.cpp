@@ -30,7 +30,8 @@ bool referenceHit(const Disc& d, Vec3f o, Vec3f dir, double& t) {
     const double den = double(dir.x) * n.x + double(dir.y) * n.y + double(dir.z) * n.z;
     if (den == 0) return false;
     t = ((double(d.center.x) - o.x) * n.x + (double(d.center.y) - o.y) * n.y + (double(d.center.z) - o.z) * n.z) / den;
-    const double px = o.x + t * dir.x - d.center.x, py = o.y + t * dir.y - d.center.y, pz = o.z + t * dir.z - d.center.z;
+    const double px = o.x + t * dir.x - d.center.x, py = o.y + t * dir.y - d.center.y,
+                 pz = o.z + t * dir.z - d.center.z;
     return t > 0 && px * px + py * py + pz * pz <= double(d.radius) * d.radius;
 }
 
@@ -144,7 +145,8 @@ void checkAgainstBruteForce(const PointScene& scene, bool commonOrigin, uint32_t
             DiscIntersector::Hit<1> h1;
             h1.t = r1.tMax;
             h1.id = Packet<1, int32_t>(-1);
-            for (size_t k = 0; k < discs.size(); ++k) DiscIntersector{}.intersect<HitData::Shading>(discs[k], uint32_t(k), r1, h1, 0);
+            for (size_t k = 0; k < discs.size(); ++k)
+                DiscIntersector{}.intersect<HitData::Shading>(discs[k], uint32_t(k), r1, h1, 0);
             const bool bf = int32_t(h1.id) >= 0;
             ASSERT_EQ(bf, hit.id[i] >= 0) << "lane " << i << " round " << round;
             EXPECT_EQ(bf, bool(occ[i])) << "occlusion lane " << i;
@@ -185,7 +187,9 @@ TEST(LoDTree, RepresentativeDiscsCoverTheirSubtrees) {
     EXPECT_TRUE(t.indices.empty());
     std::vector<int> seen(t.elems.size(), 0);
     // Walk the tree collecting each node's element range, then check cover and extents.
-    struct Range { uint32_t first, count; };
+    struct Range {
+        uint32_t first, count;
+    };
     std::vector<Range> range(t.nodes.size());
     std::function<Range(uint32_t)> walk = [&](uint32_t node) -> Range {
         const KdNode& n = t.nodes[node];
@@ -197,8 +201,10 @@ TEST(LoDTree, RepresentativeDiscsCoverTheirSubtrees) {
         EXPECT_EQ(a.first + a.count, b.first);  // subtrees are contiguous in leaf order
         const LoDInner& in = t.inner[LoDKdTree::innerIndex(n)];
         // The quantised child boxes contain their discs.
-        for (uint32_t i = a.first; i < a.first + a.count; ++i) EXPECT_TRUE(in.box(0).contains(t.elems[i].bounds())) << node;
-        for (uint32_t i = b.first; i < b.first + b.count; ++i) EXPECT_TRUE(in.box(1).contains(t.elems[i].bounds())) << node;
+        for (uint32_t i = a.first; i < a.first + a.count; ++i)
+            EXPECT_TRUE(in.box(0).contains(t.elems[i].bounds())) << node;
+        for (uint32_t i = b.first; i < b.first + b.count; ++i)
+            EXPECT_TRUE(in.box(1).contains(t.elems[i].bounds())) << node;
         const Disc& rep = in.rep;
         for (uint32_t i = a.first; i < b.first + b.count; ++i) {
             const Disc& d = t.elems[i];
@@ -237,7 +243,9 @@ RepHitStats checkRepresentativeHits(const std::vector<Disc>& discs) {
     scene.build(discs);
     const LoDKdTree& t = scene.tree;
     // Element range of the subtree under each inner node, by inner index.
-    struct Range { uint32_t first = 0, count = 0; };
+    struct Range {
+        uint32_t first = 0, count = 0;
+    };
     std::vector<Range> sub(t.inner.size());
     std::function<Range(uint32_t)> walk = [&](uint32_t node) -> Range {
         const KdNode& n = t.nodes[node];

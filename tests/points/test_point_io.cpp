@@ -1,9 +1,8 @@
 // Loaders: the same cloud through every format and encoding; hostile files (truncated,
 // lying counts, NaN points, empty clouds, garbage) give rtfact::Error with a clear
 // message, never a crash or a huge allocation.
-#include <gtest/gtest.h>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -50,8 +49,11 @@ const int Col[3][3] = {{255, 0, 0}, {0, 255, 0}, {10, 20, 30}};
 std::string plyHeader(const std::string& fmt, int n, bool floatColor = false) {
     const std::string ct = floatColor ? "float" : "uchar";
     return "ply\nformat " + fmt + " 1.0\ncomment test\nelement vertex " + std::to_string(n) +
-           "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
-           "property " + ct + " red\nproperty " + ct + " green\nproperty " + ct + " blue\nproperty float radius\nproperty float intensity\nend_header\n";
+           "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty "
+           "float nz\n"
+           "property " +
+           ct + " red\nproperty " + ct + " green\nproperty " + ct +
+           " blue\nproperty float radius\nproperty float intensity\nend_header\n";
 }
 std::string binaryPly(bool be, bool floatColor = false, int declared = 3) {
     std::string s = plyHeader(be ? "binary_big_endian" : "binary_little_endian", declared, floatColor);
@@ -59,8 +61,10 @@ std::string binaryPly(bool be, bool floatColor = false, int declared = 3) {
         for (int a = 0; a < 3; ++a) put(s, P[i][a], be);
         for (int a = 0; a < 3; ++a) put(s, Nn[i][a], be);
         for (int a = 0; a < 3; ++a) {
-            if (floatColor) put(s, float(Col[i][a]) / 255.0f, be);
-            else s.push_back(char(uint8_t(Col[i][a])));
+            if (floatColor)
+                put(s, float(Col[i][a]) / 255.0f, be);
+            else
+                s.push_back(char(uint8_t(Col[i][a])));
         }
         put(s, 0.25f * float(i + 1), be);
         put(s, 100.0f * float(i), be);
@@ -128,8 +132,9 @@ TEST(PlyLoader, WriteReadRoundTrip) {
 }
 
 TEST(PlyLoader, SkipsElementsBeforeVertices) {
-    std::string s = "ply\nformat binary_little_endian 1.0\nelement junk 2\nproperty list uchar int idx\nelement vertex 1\n"
-                    "property float x\nproperty float y\nproperty float z\nend_header\n";
+    std::string s =
+        "ply\nformat binary_little_endian 1.0\nelement junk 2\nproperty list uchar int idx\nelement vertex 1\n"
+        "property float x\nproperty float y\nproperty float z\nend_header\n";
     s.push_back(2), put(s, 1), put(s, 2);
     s.push_back(0);
     put(s, 1.0f), put(s, 2.0f), put(s, 3.0f);
@@ -139,7 +144,9 @@ TEST(PlyLoader, SkipsElementsBeforeVertices) {
 }
 
 TEST(PlyLoader, LargeCoordinatesAreShiftedInDouble) {
-    std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+    std::string s =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double "
+        "z\nend_header\n";
     put(s, 512050.25), put(s, 5403060.5), put(s, 300.0);
     put(s, 512051.75), put(s, 5403061.0), put(s, 301.0);
     const PointCloud c = loadPly(writeFile("utm.ply", s));
@@ -149,7 +156,9 @@ TEST(PlyLoader, LargeCoordinatesAreShiftedInDouble) {
 }
 
 TEST(PlyLoader, NaNPointsAreDroppedAndCounted) {
-    std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    std::string s =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+        "z\nend_header\n";
     put(s, 0.0f), put(s, 0.0f), put(s, 0.0f);
     put(s, std::nanf("")), put(s, 1.0f), put(s, 1.0f);
     put(s, 1.0f), put(s, 1.0f), put(s, 1.0f);
@@ -169,15 +178,30 @@ TEST(PlyLoader, HostileFiles) {
     expectError([&] { loadPly(writeFile("zero.ply", "")); }, "not a PLY file");
     const std::string asc = asciiPly();
     expectError([&] { loadPly(writeFile("trunc_ascii.ply", asc.substr(0, asc.size() - 20))); }, "truncated");
-    expectError([&] { loadPly(writeFile("bad_ascii.ply", plyHeader("ascii", 1) + "1 2 x 0 0 1 1 2 3 1 1\n")); }, "bad number");
-    std::string allNan = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\nnan 0 0\n0 nan 0\n";
+    expectError([&] { loadPly(writeFile("bad_ascii.ply", plyHeader("ascii", 1) + "1 2 x 0 0 1 1 2 3 1 1\n")); },
+                "bad number");
+    std::string allNan =
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float "
+        "z\nend_header\nnan 0 0\n0 nan 0\n";
     expectError([&] { loadPly(writeFile("allnan.ply", allNan)); }, "no point with finite coordinates");
-    expectError([&] { loadPly(writeFile("noxyz.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\nend_header\n1\n")); }, "lack x");
-    expectError([&] { loadPly(writeFile("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n1\n")); }, "unknown PLY property type");
+    expectError(
+        [&] {
+            loadPly(
+                writeFile("noxyz.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float a\nend_header\n1\n"));
+        },
+        "lack x");
+    expectError(
+        [&] {
+            loadPly(
+                writeFile("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n1\n"));
+        },
+        "unknown PLY property type");
     expectError([&] { loadPointCloud((tmpDir() / "missing.ply").string()); }, "no such file");
     // Infinite coordinates count as non-finite; a little-endian body declared big-endian
     // decodes to absurd but finite values, or NaNs: loads or fails cleanly, never crashes.
-    std::string allInf = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\ninf 0 0\n0 -inf 0\n";
+    std::string allInf =
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float "
+        "z\nend_header\ninf 0 0\n0 -inf 0\n";
     expectError([&] { loadPly(writeFile("allinf.ply", allInf)); }, "no point with finite coordinates");
     std::string inf1 = allInf;
     inf1.replace(inf1.find("0 -inf 0"), 8, "0 1 0");
@@ -186,8 +210,9 @@ TEST(PlyLoader, HostileFiles) {
 }
 
 TEST(PlyProbe, MeshesAreNotPointClouds) {
-    const std::string mesh = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const std::string mesh =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     const std::string f = writeFile("mesh.ply", mesh);
     EXPECT_FALSE(probePointFile(f).has_value());
     const TriangleMesh m = loadPlyMesh(f);
@@ -201,7 +226,8 @@ TEST(PlyProbe, MeshesAreNotPointClouds) {
 namespace {
 std::string pcdHeader(const std::string& data, int points, const std::string& fields = "x y z intensity") {
     return "# .PCD v0.7\nVERSION 0.7\nFIELDS " + fields + "\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " +
-           std::to_string(points) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " + data + "\n";
+           std::to_string(points) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) +
+           "\nDATA " + data + "\n";
 }
 }  // namespace
 
@@ -222,7 +248,9 @@ TEST(PcdLoader, AsciiAndBinary) {
 }
 
 TEST(PcdLoader, PackedRgb) {
-    std::string b = "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA binary\n";
+    std::string b =
+        "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA "
+        "binary\n";
     put(b, 1.f), put(b, 2.f), put(b, 3.f), put(b, uint32_t(0x00112233));
     const PointCloud c = loadPointCloud(writeFile("rgb.pcd", b));
     ASSERT_EQ(c.colors.size(), 1u);
@@ -247,7 +275,9 @@ TEST(PcdLoader, HostileFiles) {
     expectError([&] { loadPcd(writeFile("wh.pcd", w + "1 2 3 4\n")); }, "differs from POINTS");
     expectError([&] { loadPcd(writeFile("nodata.pcd", "VERSION 0.7\nFIELDS x y z\n")); }, "no DATA");
     expectError([&] { loadPcd(writeFile("asc_trunc.pcd", pcdHeader("ascii", 3) + "1 2 3 4\n1 2 3 4\n")); }, "PCD");
-    expectError([&] { loadPcd(writeFile("garbage.pcd", std::string("\x89PNG\r\n\x1a\n", 8) + std::string(64, '\x01'))); }, "PCD");
+    expectError(
+        [&] { loadPcd(writeFile("garbage.pcd", std::string("\x89PNG\r\n\x1a\n", 8) + std::string(64, '\x01'))); },
+        "PCD");
     // Negative, zero and overflowing sizes; all-NaN and all-Inf bodies; a directory.
     expectError([&] { loadPcd(writeFile("negpoints.pcd", pcdHeader("ascii", -3) + "1 2 3 4\n")); }, "PCD");
     std::string zeroSize = pcdHeader("binary", 1);
@@ -260,15 +290,20 @@ TEST(PcdLoader, HostileFiles) {
     // then allocated 12 GB by its own reading of the number.
     std::string overflowCount = pcdHeader("binary", 1);
     overflowCount.replace(overflowCount.find("COUNT 1 1 1 1"), 13, "COUNT 19999999999999999999999 1 1 1");
-    expectError([&] { loadPcd(writeFile("overflowcount.pcd", overflowCount + std::string(16, '\0'))); }, "bad PCD COUNT");
+    expectError([&] { loadPcd(writeFile("overflowcount.pcd", overflowCount + std::string(16, '\0'))); },
+                "bad PCD COUNT");
     std::string wh = pcdHeader("binary", 1);
     wh.replace(wh.find("WIDTH 1\nHEIGHT 1"), 16, "WIDTH 4294967296\nHEIGHT 4294967296");
     expectError([&] { loadPcd(writeFile("overflow.pcd", wh + std::string(16, '\0'))); }, "PCD");
-    expectError([&] { loadPcd(writeFile("allnan.pcd", pcdHeader("ascii", 2) + "nan 0 0 1\n0 nan 0 1\n")); }, "no point with finite coordinates");
-    expectError([&] { loadPcd(writeFile("allinf.pcd", pcdHeader("ascii", 2) + "inf 0 0 1\n0 -inf 0 1\n")); }, "no point with finite coordinates");
+    expectError([&] { loadPcd(writeFile("allnan.pcd", pcdHeader("ascii", 2) + "nan 0 0 1\n0 nan 0 1\n")); },
+                "no point with finite coordinates");
+    expectError([&] { loadPcd(writeFile("allinf.pcd", pcdHeader("ascii", 2) + "inf 0 0 1\n0 -inf 0 1\n")); },
+                "no point with finite coordinates");
     // Found by fuzz_pcd: a "\r" line ends PCL's header parse and PCL then crashed on the body.
-    expectError([&] { loadPcd(writeFile("cr_line.pcd", "#c\r\n\r\n" + pcdHeader("ascii", 1) + "1 2 3 4\n")); }, "blank line");
-    expectError([&] { loadPcd(writeFile("short_row.pcd", pcdHeader("ascii", 2) + "10 20 30 40\n10 20 30\n")); }, "point 2 has 3 values");
+    expectError([&] { loadPcd(writeFile("cr_line.pcd", "#c\r\n\r\n" + pcdHeader("ascii", 1) + "1 2 3 4\n")); },
+                "blank line");
+    expectError([&] { loadPcd(writeFile("short_row.pcd", pcdHeader("ascii", 2) + "10 20 30 40\n10 20 30\n")); },
+                "point 2 has 3 values");
     // Odd header tokens that PCL's own parser mishandled (a use-after-free found by fuzz_pcd).
     std::string oddField = pcdHeader("ascii", 1, "x y z\xec\xec i");
     expectError([&] { loadPcd(writeFile("oddfield.pcd", oddField + "1 2 3 4\n")); }, "bad PCD field name");
@@ -312,12 +347,14 @@ TEST(XyzLoader, HostileFiles) {
     expectError([&] { loadXyz(writeFile("empty.xyz", "\n\n")); }, "empty point cloud");
     expectError([&] { loadXyz(writeFile("nan.xyz", "nan 0 0\n0 nan 0\n")); }, "no point with finite coordinates");
     expectError([&] { loadXyz(writeFile("lying.pts", "1000000000\n0 0 0\n")); }, "file is too small");
-    expectError([&] { loadXyz(writeFile("short.pts", "3\n0.000000 0.000000 0.000000\n1.000000 1.000000 1.000000\n")); }, "truncated");
+    expectError([&] { loadXyz(writeFile("short.pts", "3\n0.000000 0.000000 0.000000\n1.000000 1.000000 1.000000\n")); },
+                "truncated");
     expectError([&] { loadXyz(writeFile("few.xyz", "1 2\n")); }, "fewer than 3");
     expectError([&] { loadXyz(writeFile("neg.pts", "-5\n0 0 0\n")); }, "neg.pts");
     expectError([&] { loadXyz(writeFile("zero.pts", "0\n")); }, "zero.pts");
     expectError([&] { loadXyz(writeFile("inf.xyz", "inf 0 0\n0 1e39 0\n")); }, "no point with finite coordinates");
-    expectError([&] { loadXyz(writeFile("binary.xyz", std::string("\x7f\x45\x4c\x46\x02\x01\x01\x00\x00\xff", 10))); }, "binary.xyz");
+    expectError([&] { loadXyz(writeFile("binary.xyz", std::string("\x7f\x45\x4c\x46\x02\x01\x01\x00\x00\xff", 10))); },
+                "binary.xyz");
     expectError([&] { loadPointCloud((tmpDir() / "missing.xyz").string()); }, "missing.xyz");
     fs::create_directories(tmpDir() / "dir.xyz");
     expectError([&] { loadPointCloud((tmpDir() / "dir.xyz").string()); }, "dir.xyz");
@@ -333,7 +370,10 @@ TEST(NonFinitePoints, CountedInEveryFormatAndAllDroppedIsAnError) {
         for (int i = first; i < 5; ++i) {
             for (int a = 0; a < 3; ++a) {
                 const double x = v[i][a];
-                s += (std::isnan(x) ? std::string("nan") : std::isinf(x) ? std::string("inf") : std::to_string(x)) + (a < 2 ? " " : "");
+                s += (std::isnan(x)   ? std::string("nan")
+                      : std::isinf(x) ? std::string("inf")
+                                      : std::to_string(x)) +
+                     (a < 2 ? " " : "");
             }
             s += sep + "\n";
         }
@@ -355,8 +395,9 @@ TEST(NonFinitePoints, CountedInEveryFormatAndAllDroppedIsAnError) {
                "\nHEIGHT 1\nPOINTS " + std::to_string(5 - first) + "\nDATA ascii\n" + text(first, "");
     };
     auto pcdBinary = [&](int first) {
-        std::string s = "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + std::to_string(5 - first) +
-                        "\nHEIGHT 1\nPOINTS " + std::to_string(5 - first) + "\nDATA binary\n";
+        std::string s = "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " +
+                        std::to_string(5 - first) + "\nHEIGHT 1\nPOINTS " + std::to_string(5 - first) +
+                        "\nDATA binary\n";
         for (int i = first; i < 5; ++i)
             for (int a = 0; a < 3; ++a) put(s, v[i][a]);
         return s;
@@ -405,8 +446,10 @@ TEST(PointLoaders, NamedPipesAreRefusedWithoutHanging) {
         for (const bool probe : {false, true}) {
             auto result = std::async(std::launch::async, [&]() -> std::string {
                 try {
-                    if (probe) probePointFile(fifo);
-                    else loadPointCloud(fifo);
+                    if (probe)
+                        probePointFile(fifo);
+                    else
+                        loadPointCloud(fifo);
                     return "no error";
                 } catch (const Error& e) {
                     return e.message();
@@ -427,13 +470,16 @@ TEST(PointLoaders, NamedPipesAreRefusedWithoutHanging) {
 // The header search stops after 1 MiB: a longer header (here a 2 MiB comment) is refused
 // naming that limit, not as a file without end_header.
 TEST(PlyLoader, HeaderLimitIsNamed) {
-    const std::string body = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n";
+    const std::string body =
+        "element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n";
     const std::string longComment = "ply\nformat ascii 1.0\ncomment " + std::string(2 << 20, 'c') + "\n" + body;
     expectError([&] { loadPly(writeFile("long_comment.ply", longComment)); }, "longer than the 1 MiB limit");
     // end_header inside a comment does not end the header.
-    const PointCloud c = loadPly(writeFile("comment_end.ply", "ply\nformat ascii 1.0\ncomment no end_header here\n" + body));
+    const PointCloud c =
+        loadPly(writeFile("comment_end.ply", "ply\nformat ascii 1.0\ncomment no end_header here\n" + body));
     ASSERT_EQ(c.size(), 1u);
     EXPECT_EQ(c.positions[0], Vec3f(1, 2, 3));
     // Without end_header in a short file: still the truncation message.
-    expectError([&] { loadPly(writeFile("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 1\n")); }, "no end_header");
+    expectError([&] { loadPly(writeFile("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 1\n")); },
+                "no end_header");
 }

@@ -90,7 +90,7 @@ constexpr int kImage = 64;
 struct TinyResult {
     std::vector<float> radii;
     int litPixels = 0;
-    std::vector<bool> pointHit;  // the ray from the eye towards each point hits a disc no farther than it
+    std::vector<bool> pointHit;       // the ray from the eye towards each point hits a disc no farther than it
     std::vector<float> radiusPixels;  // each disc's radius in pixels at its distance
 };
 

@@ -47,7 +47,8 @@ constexpr int kSize = 160;
 }
 
 template <class Integrator = EyeLightIntegrator>
-std::vector<float> render(const PointScene& scene, const CameraFrame& frame, float quality, const Integrator& integ = {}) {
+std::vector<float> render(const PointScene& scene, const CameraFrame& frame, float quality,
+                          const Integrator& integ = {}) {
     const PinholeCamera cam(frame, kSize, kSize);
     const_cast<PointScene&>(scene).setLoD(cam.cone(), quality);
     RGBAFramebuffer fb(kSize, kSize);
@@ -68,7 +69,8 @@ TEST(PointRender, DirectAOAndLoDMatchReferences) {
     const std::string dir = RTFACT_TEST_DATA;
     DirectLightIntegrator direct;
     const AABB b = scene.bounds();
-    direct.lights.push_back(PointLight{frame.eye + Vec3f(0, 1, 0) * length(b.extent()), Vec3f(2.5f * dot(b.extent(), b.extent()))});
+    direct.lights.push_back(
+        PointLight{frame.eye + Vec3f(0, 1, 0) * length(b.extent()), Vec3f(2.5f * dot(b.extent(), b.extent()))});
     direct.lights.push_back(DirectionalLight{{0.3f, -1.0f, -0.4f}, Vec3f(0.5f)});
     test::expectMatchesReference(dir + "/bunny_bun000_direct.png", kSize, kSize, render(scene, frame, 0.0f, direct));
     AOIntegrator ao;

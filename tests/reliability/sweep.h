@@ -5,14 +5,14 @@
 // foreign exception fails.
 #pragma once
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <csignal>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -63,11 +63,14 @@ using Loader = std::function<void(const std::string&)>;
 
 // What a rejection must look like: the error names the file, or the data file / material
 // library / texture it points to (all in the output directory), on one line.
-inline std::string clip(const std::string& s) { return s.size() > 300 ? s.substr(0, 300) + "... (" + std::to_string(s.size()) + " chars)" : s; }
+inline std::string clip(const std::string& s) {
+    return s.size() > 300 ? s.substr(0, 300) + "... (" + std::to_string(s.size()) + " chars)" : s;
+}
 constexpr size_t kMaxMessage = 4096;  // a one-line error, not a dump of the file
 inline bool goodError(const std::string& path, const Error& e) {
     const std::string m = e.what();
-    return (e.file() == path || e.file().rfind(outDir(), 0) == 0) && m.find('\n') == std::string::npos && m.size() < kMaxMessage;
+    return (e.file() == path || e.file().rfind(outDir(), 0) == 0) && m.find('\n') == std::string::npos &&
+           m.size() < kMaxMessage;
 }
 inline void checkError(const std::string& path, const std::string& what, const Error& e) {
     const std::string m = e.what();
@@ -91,7 +94,9 @@ inline void isolated(const std::string& path, const std::string& what, const Loa
             load(path);
         } catch (const Error& e) {
             code = goodError(path, e) ? 1 : 2;
-            if (code == 2) std::fprintf(stderr, "%s: bad error '%s': %s\n", what.c_str(), e.file().c_str(), clip(e.what()).c_str());
+            if (code == 2)
+                std::fprintf(stderr, "%s: bad error '%s': %s\n", what.c_str(), e.file().c_str(),
+                             clip(e.what()).c_str());
         } catch (const std::exception& e) {
             std::fprintf(stderr, "%s: foreign exception %s\n", what.c_str(), e.what());
             code = 3;
@@ -102,14 +107,20 @@ inline void isolated(const std::string& path, const std::string& what, const Loa
     int status = 0;
     waitpid(pid, &status, 0);
     if (WIFSIGNALED(status)) {
-        ADD_FAILURE() << what << ": " << (WTERMSIG(status) == SIGALRM ? "hang (SIGALRM)" : "crash, signal " + std::to_string(WTERMSIG(status)));
+        ADD_FAILURE() << what << ": "
+                      << (WTERMSIG(status) == SIGALRM ? "hang (SIGALRM)"
+                                                      : "crash, signal " + std::to_string(WTERMSIG(status)));
         return;
     }
     const int code = WEXITSTATUS(status);
-    if (code == 0) ++o.loaded;
-    else if (code == 1) ++o.rejected;
-    else if (code == 2) ++o.rejected, ADD_FAILURE() << what << ": error not naming the file or not one line (see stderr)";
-    else ADD_FAILURE() << what << ": foreign exception (see stderr)";
+    if (code == 0)
+        ++o.loaded;
+    else if (code == 1)
+        ++o.rejected;
+    else if (code == 2)
+        ++o.rejected, ADD_FAILURE() << what << ": error not naming the file or not one line (see stderr)";
+    else
+        ADD_FAILURE() << what << ": foreign exception (see stderr)";
 }
 
 // Runs `load` on the intact `bytes` (which must load) and on its variants; returns how
@@ -167,7 +178,8 @@ inline Outcome hammerBytes(const std::string& bytes, const std::string& ext, con
     std::mt19937 rng(17);
     for (int k = 0; k < 40; ++k) {
         std::string v = bytes;
-        for (int j = 0; j < 4; ++j) v[rng() % std::min<size_t>(v.size(), 4096 + (k % 2) * v.size())] ^= char(1 << (rng() % 8));
+        for (int j = 0; j < 4; ++j)
+            v[rng() % std::min<size_t>(v.size(), 4096 + (k % 2) * v.size())] ^= char(1 << (rng() % 8));
         attempt(v, "bytes flipped, variant " + std::to_string(k));
     }
     std::printf("[  sweep   ] %s (%s, %zu bytes): %d variants, %d loaded, %d rejected; slowest %.3f s (%s)\n",

@@ -21,8 +21,8 @@
 #include "points/point_cloud_io.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
-#include "volume/volume_io.h"
 #include "sweep.h"
+#include "volume/volume_io.h"
 
 using namespace rtfact;
 using namespace rtfact::reliability;
@@ -80,7 +80,8 @@ std::vector<Pt> cloudPoints() {
     for (int i = 0; i < kPoints; ++i) {
         const float t = float(i) * 0.37f, s = float(i) * 0.11f;
         p.push_back({std::cos(t) * std::sin(s) + 0.25f, std::sin(t) * std::sin(s) - 1.5f, std::cos(s) * 2.0f,
-                     float(i % 7) * 10.0f, uint32_t((i * 40) % 256) << 16 | uint32_t((i * 17) % 256) << 8 | uint32_t(i * 5 % 256)});
+                     float(i % 7) * 10.0f,
+                     uint32_t((i * 40) % 256) << 16 | uint32_t((i * 17) % 256) << 8 | uint32_t(i * 5 % 256)});
     }
     return p;
 }
@@ -124,7 +125,8 @@ std::string xyzText() {
     std::string s;
     for (const Pt& p : cloudPoints()) {
         const float l = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
-        s += num(p.x) + " " + num(p.y) + " " + num(p.z) + " " + num(p.x / l) + " " + num(p.y / l) + " " + num(p.z / l) + "\n";
+        s += num(p.x) + " " + num(p.y) + " " + num(p.z) + " " + num(p.x / l) + " " + num(p.y / l) + " " + num(p.z / l) +
+             "\n";
     }
     return s;
 }
@@ -132,8 +134,8 @@ std::string ptsText() {
     // count, then x y z intensity r g b
     std::string s = std::to_string(kPoints) + "\n";
     for (const Pt& p : cloudPoints())
-        s += num(p.x) + " " + num(p.y) + " " + num(p.z) + " " + num(p.intensity) + " " + std::to_string(p.rgb >> 16) + " " +
-             std::to_string((p.rgb >> 8) & 255) + " " + std::to_string(p.rgb & 255) + "\n";
+        s += num(p.x) + " " + num(p.y) + " " + num(p.z) + " " + num(p.intensity) + " " + std::to_string(p.rgb >> 16) +
+             " " + std::to_string((p.rgb >> 8) & 255) + " " + std::to_string(p.rgb & 255) + "\n";
     return s;
 }
 
@@ -232,23 +234,29 @@ std::string vtkLegacy() {
                     std::to_string(m.v.size()) + " float\n";
     for (const auto& v : m.v) s += num(v[0]) + " " + num(v[1]) + " " + num(v[2]) + "\n";
     s += "POLYGONS " + std::to_string(m.tris.size()) + " " + std::to_string(4 * m.tris.size()) + "\n";
-    for (const auto& t : m.tris) s += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+    for (const auto& t : m.tris)
+        s += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
     s += "POINT_DATA " + std::to_string(m.v.size()) + "\nTEXTURE_COORDINATES uv 2 float\n";
     for (const auto& t : m.uv) s += num(t[0]) + " " + num(t[1]) + "\n";
     return s;
 }
 std::string vtpXml() {
     const GridMesh m = gridMesh();
-    std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
-                    "<Piece NumberOfPoints=\"" +
-                    std::to_string(m.v.size()) + "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
-                    std::to_string(m.tris.size()) + "\">\n<PointData TCoords=\"uv\">\n"
-                    "<DataArray type=\"Float32\" Name=\"uv\" NumberOfComponents=\"2\" format=\"ascii\">\n";
+    std::string s =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
+        "<Piece NumberOfPoints=\"" +
+        std::to_string(m.v.size()) +
+        "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
+        std::to_string(m.tris.size()) +
+        "\">\n<PointData TCoords=\"uv\">\n"
+        "<DataArray type=\"Float32\" Name=\"uv\" NumberOfComponents=\"2\" format=\"ascii\">\n";
     for (const auto& t : m.uv) s += num(t[0]) + " " + num(t[1]) + "\n";
-    s += "</DataArray>\n</PointData>\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    s += "</DataArray>\n</PointData>\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
     for (const auto& v : m.v) s += num(v[0]) + " " + num(v[1]) + " " + num(v[2]) + "\n";
     s += "</DataArray>\n</Points>\n<Polys>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (const auto& t : m.tris) s += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+    for (const auto& t : m.tris)
+        s += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
     s += "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
     for (size_t k = 0; k < m.tris.size(); ++k) s += std::to_string(3 * (k + 1)) + (k % 8 == 7 ? "\n" : " ");
     s += "\n</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
@@ -272,11 +280,12 @@ std::string u16Payload() {
     return s;
 }
 std::string nrrdHeader(const std::string& encoding, const std::string& dataFile) {
-    std::string s = "NRRD0004\n# rtfact reliability sweep\ntype: unsigned short\ndimension: 3\nsizes: " + std::to_string(kNx) + " " +
-                    std::to_string(kNy) + " " + std::to_string(kNz) +
-                    "\nspace: left-posterior-superior\nspace directions: (0.5,0,0) (0,0.5,0) (0,0,1.25)\n"
-                    "space origin: (-2.5,-2,0)\nkinds: domain domain domain\nendian: little\nencoding: " +
-                    encoding + "\n";
+    std::string s =
+        "NRRD0004\n# rtfact reliability sweep\ntype: unsigned short\ndimension: 3\nsizes: " + std::to_string(kNx) +
+        " " + std::to_string(kNy) + " " + std::to_string(kNz) +
+        "\nspace: left-posterior-superior\nspace directions: (0.5,0,0) (0,0.5,0) (0,0,1.25)\n"
+        "space origin: (-2.5,-2,0)\nkinds: domain domain domain\nendian: little\nencoding: " +
+        encoding + "\n";
     if (!dataFile.empty()) s += "data file: " + dataFile + "\n";
     return s + "\n";
 }
@@ -308,12 +317,13 @@ std::string nifti() {
     return h + data;
 }
 std::string vti() {
-    std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-                    "<ImageData WholeExtent=\"0 " +
-                    std::to_string(kNx - 1) + " 0 " + std::to_string(kNy - 1) + " 0 " + std::to_string(kNz - 1) +
-                    "\" Origin=\"0 0 0\" Spacing=\"0.5 0.5 1.25\">\n<Piece Extent=\"0 " + std::to_string(kNx - 1) + " 0 " +
-                    std::to_string(kNy - 1) + " 0 " + std::to_string(kNz - 1) +
-                    "\">\n<PointData Scalars=\"density\">\n<DataArray type=\"UInt8\" Name=\"density\" format=\"ascii\">\n";
+    std::string s =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+        "<ImageData WholeExtent=\"0 " +
+        std::to_string(kNx - 1) + " 0 " + std::to_string(kNy - 1) + " 0 " + std::to_string(kNz - 1) +
+        "\" Origin=\"0 0 0\" Spacing=\"0.5 0.5 1.25\">\n<Piece Extent=\"0 " + std::to_string(kNx - 1) + " 0 " +
+        std::to_string(kNy - 1) + " 0 " + std::to_string(kNz - 1) +
+        "\">\n<PointData Scalars=\"density\">\n<DataArray type=\"UInt8\" Name=\"density\" format=\"ascii\">\n";
     int n = 0;
     for (int k = 0; k < kNz; ++k)
         for (int j = 0; j < kNy; ++j)
@@ -331,7 +341,8 @@ std::string vdbBytes(uint32_t compression) {
     for (int k = 0; k < kNz; ++k)
         for (int j = 0; j < kNy; ++j)
             for (int i = 0; i < kNx; ++i)
-                if ((i + j + k) % 3 != 0) acc.setValue(openvdb::Coord(i + 1, j + 2, k + 3), float(voxel(i, j, k)) / 4000.0f);
+                if ((i + j + k) % 3 != 0)
+                    acc.setValue(openvdb::Coord(i + 1, j + 2, k + 3), float(voxel(i, j, k)) / 4000.0f);
     const std::string tmp = sweepPath(".tmp.vdb");
     openvdb::io::File f(tmp);
     f.setCompression(compression);

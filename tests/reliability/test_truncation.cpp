@@ -12,9 +12,9 @@
 #include "core/util/error.h"
 #include "points/point_cloud_io.h"
 #include "surfaces/mesh_loader.h"
+#include "sweep.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_io.h"
-#include "sweep.h"
 
 namespace fs = std::filesystem;
 using namespace rtfact;
@@ -67,9 +67,9 @@ TEST(Hostile, DirectoriesAndMissingFiles) {
     const Loader vol = [&](const std::string& p) { (void)volume::loadVolume(p, quiet); };
     const Loader tf = [](const std::string& p) { (void)volume::loadTransferFunction(p); };
     const std::vector<std::pair<std::string, std::vector<Loader>>> cases = {
-        {".ply", {mesh, cloud}}, {".pcd", {cloud}}, {".xyz", {cloud}}, {".pts", {cloud}},   {".obj", {mesh}},
-        {".stl", {mesh}},        {".vtk", {mesh}},  {".vtp", {mesh}},  {".mhd", {vol}},     {".nrrd", {vol}},
-        {".nii", {vol}},         {".nii.gz", {vol}}, {".vti", {vol}},  {".vdb", {vol}},     {".json", {tf}}};
+        {".ply", {mesh, cloud}}, {".pcd", {cloud}},  {".xyz", {cloud}}, {".pts", {cloud}}, {".obj", {mesh}},
+        {".stl", {mesh}},        {".vtk", {mesh}},   {".vtp", {mesh}},  {".mhd", {vol}},   {".nrrd", {vol}},
+        {".nii", {vol}},         {".nii.gz", {vol}}, {".vti", {vol}},   {".vdb", {vol}},   {".json", {tf}}};
     int checked = 0;
     for (const auto& [ext, loaders] : cases) {
         const std::string dir = outDir() + "/a_directory" + ext;
@@ -84,7 +84,8 @@ TEST(Hostile, DirectoriesAndMissingFiles) {
                     ADD_FAILURE() << what << ": accepted";
                 } catch (const Error& e) {
                     EXPECT_EQ(e.file(), p) << what << ": " << e.what();
-                    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << what << ": one line: " << e.what();
+                    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos)
+                        << what << ": one line: " << e.what();
                 } catch (const std::exception& e) {
                     ADD_FAILURE() << what << ": foreign exception " << e.what();
                 }

@@ -1,19 +1,17 @@
 // Mesh loaders on good files of every format and on truncated, malformed and hostile
 // ones: every bad file must give a one-line rtfact::Error, never a crash or a huge
 // allocation; the CLI turns it into "rtfact: error: <file>: <what>" and exit code 1.
+#include <fcntl.h>
 #include <gtest/gtest.h>
-
-#include <limits>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <future>
-
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
+#include <limits>
 
 #include "core/util/error.h"
 #include "surfaces/mesh_loader.h"
@@ -43,15 +41,17 @@ const char* kCubeVerts = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1
 const char* kCubeFaces = "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n";
 
 std::string asciiPly() {
-    return std::string("ply\nformat ascii 1.0\ncomment unit cube\nelement vertex 8\nproperty float x\nproperty float y\n"
-                       "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n") +
+    return std::string(
+               "ply\nformat ascii 1.0\ncomment unit cube\nelement vertex 8\nproperty float x\nproperty float y\n"
+               "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n") +
            kCubeVerts + kCubeFaces;
 }
 
 std::string binaryPly(uint32_t faceCountInHeader, bool truncate) {
-    std::string h = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                    "property float z\nelement face " + std::to_string(faceCountInHeader) +
-                    "\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string h =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face " +
+        std::to_string(faceCountInHeader) + "\nproperty list uchar int vertex_indices\nend_header\n";
     const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     h.append(reinterpret_cast<const char*>(v), sizeof(v));
     h.push_back(char(3));
@@ -98,8 +98,9 @@ TEST(MeshLoader, BinaryPly) {
 
 TEST(MeshLoader, ObjWithMtlMaterialsAndUVs) {
     write("two.mtl", "newmtl red\nKd 1 0 0\nnewmtl glass\nKd 1 1 1\nNi 1.5\nd 0.1\nmap_Kd tex.png\n");
-    const std::string p = write("two.obj", "mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-                                           "vn 0 0 1\nusemtl red\nf 1/1/1 2/2/1 3/3/1\nusemtl glass\nf -4/4/1 -2/3/1 -1/4/1\n");
+    const std::string p = write("two.obj",
+                                "mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                "vn 0 0 1\nusemtl red\nf 1/1/1 2/2/1 3/3/1\nusemtl glass\nf -4/4/1 -2/3/1 -1/4/1\n");
     const Mesh m = loadMesh(p);
     EXPECT_EQ(m.triangles(), 2u);
     ASSERT_EQ(m.materials.size(), 2u);
@@ -113,8 +114,9 @@ TEST(MeshLoader, ObjWithMtlMaterialsAndUVs) {
 }
 
 TEST(MeshLoader, StlAsciiAndBinary) {
-    const Mesh a = loadMesh(write("tri_ascii.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
-                                                   "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n"));
+    const Mesh a = loadMesh(write("tri_ascii.stl",
+                                  "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                                  "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n"));
     EXPECT_EQ(a.triangles(), 1u);
     std::string b(80, ' ');
     const uint32_t n = 1;
@@ -126,8 +128,9 @@ TEST(MeshLoader, StlAsciiAndBinary) {
 }
 
 TEST(MeshLoader, VtkLegacyAndVtp) {
-    const Mesh a = loadMesh(write("tri.vtk", "# vtk DataFile Version 3.0\ntri\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
-                                             "0 0 0 1 0 0 1 1 0 0 1 0\nPOLYGONS 1 5\n4 0 1 2 3\n"));
+    const Mesh a = loadMesh(write("tri.vtk",
+                                  "# vtk DataFile Version 3.0\ntri\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
+                                  "0 0 0 1 0 0 1 1 0 0 1 0\nPOLYGONS 1 5\n4 0 1 2 3\n"));
     EXPECT_EQ(a.triangles(), 2u);
     const Mesh b = loadMesh(write("tri.vtp", R"(<?xml version="1.0"?>
 <VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">
@@ -151,8 +154,9 @@ TEST(MeshLoader, SeveralFilesMerge) {
 TEST(MeshLoader, KindDetection) {
     EXPECT_EQ(meshFileKind(write("k.ply", asciiPly())), MeshFileKind::Ply);
     // A PLY without faces is a point cloud: not ours.
-    EXPECT_EQ(meshFileKind(write("pts.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                                            "property float z\nend_header\n0 0 0\n")),
+    EXPECT_EQ(meshFileKind(write("pts.ply",
+                                 "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                                 "property float z\nend_header\n0 0 0\n")),
               MeshFileKind::NotMesh);
     EXPECT_EQ(meshFileKind(write("vol.vtk", "# vtk DataFile Version 3.0\nv\nASCII\nDATASET STRUCTURED_POINTS\n")),
               MeshFileKind::NotMesh);
@@ -165,17 +169,21 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
     expectError(write("trunc.ply", binaryPly(1, true)), "truncated");
     expectError(write("lying.ply", binaryPly(1000000000u, false)), "lying");
     expectError(write("nohead.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"), "end_header");
-    expectError(write("badtype.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n0\n"), "type");
-    expectError(write("points.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                                    "property float z\nend_header\n0 0 0\n"),
+    expectError(write("badtype.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n0\n"),
+                "type");
+    expectError(write("points.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                      "property float z\nend_header\n0 0 0\n"),
                 "no faces");
-    expectError(write("nan.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                                 "0 0 0\nnan 1 0\n0 1 0\n3 0 1 2\n"),
+    expectError(write("nan.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                      "0 0 0\nnan 1 0\n0 1 0\n3 0 1 2\n"),
                 "NaN");
-    expectError(write("range.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                   "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                                   "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
+    expectError(write("range.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                      "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
                 "vertex");
     expectError(write("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n"), "out of range");
     expectError(write("noface.obj", "v 0 0 0\nv 1 0 0\n"), "no faces");
@@ -185,15 +193,20 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
     const uint32_t n = 100000000u;
     stl.append(reinterpret_cast<const char*>(&n), 4);
     expectError(write("lying.stl", stl + std::string(50, '\0')), "STL");
-    expectError(write("lying.vtk", "# vtk DataFile Version 3.0\nx\nBINARY\nDATASET POLYDATA\nPOINTS 900000000 float\n"), "lying");
-    expectError(write("lying_polys.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
-                                         "POLYGONS 900000000 900000000\n3 0 1 2\n"), "lying");
+    expectError(write("lying.vtk", "# vtk DataFile Version 3.0\nx\nBINARY\nDATASET POLYDATA\nPOINTS 900000000 float\n"),
+                "lying");
+    expectError(write("lying_polys.vtk",
+                      "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                      "POLYGONS 900000000 900000000\n3 0 1 2\n"),
+                "lying");
     expectError(write("notvtk.vtk", "hello\n"), "VTK");
-    expectError(write("lying.vtp", "<VTKFile type=\"PolyData\"><PolyData><Piece NumberOfPoints=\"999999999999\" "
-                                   "NumberOfPolys=\"1\"></Piece></PolyData></VTKFile>"),
+    expectError(write("lying.vtp",
+                      "<VTKFile type=\"PolyData\"><PolyData><Piece NumberOfPoints=\"999999999999\" "
+                      "NumberOfPolys=\"1\"></Piece></PolyData></VTKFile>"),
                 "VTP");
-    expectError(write("garbage.vtp", "<VTKFile type=\"PolyData\"><PolyData><Piece NumberOfPoints=\"3\" NumberOfPolys=\"1\">"
-                                     "<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0"));
+    expectError(write("garbage.vtp",
+                      "<VTKFile type=\"PolyData\"><PolyData><Piece NumberOfPoints=\"3\" NumberOfPolys=\"1\">"
+                      "<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0"));
     expectError(write("unknown.xyz3", "1 2 3\n"), "unknown mesh format");
     // Corrupted binary face list (count byte 3 -> 200): VTK's PLY reader crashed here.
     std::string corrupt = binaryPly(1, false);
@@ -206,9 +219,10 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
     // Wrong magic, negative counts, infinite coordinates, the wrong byte order.
     expectError(write("magic.ply", "plx\nformat ascii 1.0\nelement vertex 3\nend_header\n"), "");
     expectError(write("negative.ply", "ply\nformat ascii 1.0\nelement vertex -3\nproperty float x\nend_header\n"), "");
-    expectError(write("inf.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                 "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                                 "0 0 0\ninf 1 0\n0 1 0\n3 0 1 2\n"),
+    expectError(write("inf.ply",
+                      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                      "0 0 0\ninf 1 0\n0 1 0\n3 0 1 2\n"),
                 "NaN");
     std::string swapped = binaryPly(1, false);
     swapped.replace(swapped.find("little"), 6, "big");  // indices read as 0x01000000...
@@ -233,14 +247,16 @@ TEST(MeshLoader, MalformedFilesGiveClearErrors) {
         expectError(d, "directory");
     }
     // Legacy VTK cell lists are checked by us before VTK reads them (it segfaulted on these).
-    const std::string vtkHead = "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n";
+    const std::string vtkHead =
+        "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n";
     expectError(write("short_polys.vtk", vtkHead + "POLYGONS 2 8\n3 0 1 2\n"), "truncated");
     expectError(write("bad_cell.vtk", vtkHead + "POLYGONS 1 4\n4 0 1 2\n"), "declares 4 points");
     expectError(write("bad_vtk_index.vtk", vtkHead + "POLYGONS 1 4\n3 0 1 7\n"), "refers to point 7");
     expectError(write("bad_section.vtk", vtkHead + "POLYGONZ 1 4\n3 0 1 2\n"), "unsupported legacy VTK section");
     // VTK legacy with fewer coordinates than declared: VTK only warns, we fail.
-    expectError(write("short.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\n"
-                                   "POLYGONS 1 4\n3 0 1 2\n"));
+    expectError(write("short.vtk",
+                      "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\n"
+                      "POLYGONS 1 4\n3 0 1 2\n"));
 }
 
 // A named pipe blocks whoever opens it until a writer comes: every mesh input (and an

@@ -6,6 +6,7 @@
 // Also: BVH and kd-tree, and all packet sizes, give the same picture.
 #include <gtest/gtest.h>
 
+#include "core/render/ao_integrator.h"
 #include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
 #include "core/render/framebuffer.h"
@@ -13,7 +14,6 @@
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/render/tile_scheduler.h"
-#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/whitted_integrator.h"
 #include "test_meshes.h"
@@ -91,8 +91,9 @@ TEST(MeshRender, AmbientOcclusionMatchesReference) {
 
 TEST(MeshRender, KdTreeAndPacketSizesGiveTheSameImage) {
     const auto a = render<BVH<Triangle>, 64>(direct());
-    for (const auto& b : {render<KdTree<Triangle>, 64>(direct()), render<BVH<Triangle>, 1>(direct()),
-                          render<BVH<Triangle>, 256>(direct()), render<KdTree<Triangle>, simd::kNativeWidth>(direct())}) {
+    for (const auto& b :
+         {render<KdTree<Triangle>, 64>(direct()), render<BVH<Triangle>, 1>(direct()),
+          render<BVH<Triangle>, 256>(direct()), render<KdTree<Triangle>, simd::kNativeWidth>(direct())}) {
         const auto d = test::compareRGBA(a, b, kW, kH, 2);
         EXPECT_LE(d.differentFraction, 0.002);
     }

@@ -31,7 +31,8 @@ struct Brute {
         h.t = r.tMax;
         h.id = -1;
         h.u = h.v = 0.0f;
-        for (size_t i = 0; i < tris.size(); ++i) TriangleIntersector{}.intersect<HitData::Shading>(tris[i], uint32_t(i), r, h, 0);
+        for (size_t i = 0; i < tris.size(); ++i)
+            TriangleIntersector{}.intersect<HitData::Shading>(tris[i], uint32_t(i), r, h, 0);
         const int id = h.id;
         return {id >= 0 ? float(h.t) : kInfinity, id};
     }
@@ -56,7 +57,8 @@ void check(bool commonOrigin) {
             const Vec3f target{0.5f * u(rng), 0.0f, 0.5f * u(rng)};
             for (int i = 0; i < N; ++i) {
                 const Vec3f o = commonOrigin ? eye : Vec3f{2.0f * u(rng), 2.0f * u(rng), 2.0f * u(rng)};
-                const Vec3f t = commonOrigin ? target + Vec3f(u(rng), u(rng), u(rng)) * 0.6f : Vec3f{u(rng), u(rng), u(rng)};
+                const Vec3f t =
+                    commonOrigin ? target + Vec3f(u(rng), u(rng), u(rng)) * 0.6f : Vec3f{u(rng), u(rng), u(rng)};
                 rays.setLane(i, o, normalize(t - o), 0.0f, kInfinity);
             }
             rays.commonOrigin = commonOrigin;
@@ -96,7 +98,8 @@ void check(bool commonOrigin) {
                 const auto [bt, bid] = brute.nearest(rays.lane(i));
                 if (std::fabs(bt - seg.tMax[i]) < 1e-4f) continue;  // too close to call
                 ++occChecked;
-                EXPECT_EQ(occ[i], bt < seg.tMax[i]) << "packet " << p << " lane " << i << " t=" << bt << " tMax=" << seg.tMax[i];
+                EXPECT_EQ(occ[i], bt < seg.tMax[i])
+                    << "packet " << p << " lane " << i << " t=" << bt << " tMax=" << seg.tMax[i];
             }
         }
         EXPECT_GT(hits, packets * N / 8);
@@ -107,15 +110,15 @@ void check(bool commonOrigin) {
 }  // namespace
 
 #define RTFACT_TRAVERSAL_TESTS(Name, Structure)                                                \
-    TEST(MeshTraversal, Name##Single) {                                                         \
-        check<Structure, 1>(true);                                                              \
-        check<Structure, 1>(false);                                                             \
-    }                                                                                           \
-    TEST(MeshTraversal, Name##NativeCommon) { check<Structure, simd::kNativeWidth>(true); }     \
-    TEST(MeshTraversal, Name##NativeDistinct) { check<Structure, simd::kNativeWidth>(false); }  \
-    TEST(MeshTraversal, Name##Packet64Common) { check<Structure, 64>(true); }                   \
-    TEST(MeshTraversal, Name##Packet64Distinct) { check<Structure, 64>(false); }                \
-    TEST(MeshTraversal, Name##Packet256Common) { check<Structure, 256>(true); }                 \
+    TEST(MeshTraversal, Name##Single) {                                                        \
+        check<Structure, 1>(true);                                                             \
+        check<Structure, 1>(false);                                                            \
+    }                                                                                          \
+    TEST(MeshTraversal, Name##NativeCommon) { check<Structure, simd::kNativeWidth>(true); }    \
+    TEST(MeshTraversal, Name##NativeDistinct) { check<Structure, simd::kNativeWidth>(false); } \
+    TEST(MeshTraversal, Name##Packet64Common) { check<Structure, 64>(true); }                  \
+    TEST(MeshTraversal, Name##Packet64Distinct) { check<Structure, 64>(false); }               \
+    TEST(MeshTraversal, Name##Packet256Common) { check<Structure, 256>(true); }                \
     TEST(MeshTraversal, Name##Packet256Distinct) { check<Structure, 256>(false); }
 
 RTFACT_TRAVERSAL_TESTS(BVH, BVH<Triangle>)

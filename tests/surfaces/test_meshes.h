@@ -25,9 +25,11 @@ inline Mesh heightField(int n, uint32_t seed = 1) {
         for (int x = 0; x < n; ++x) {
             // Alternate the diagonal so edges of every direction occur.
             if ((x + z) & 1) {
-                m.indices.insert(m.indices.end(), {v(x, z), v(x + 1, z), v(x + 1, z + 1), v(x, z), v(x + 1, z + 1), v(x, z + 1)});
+                m.indices.insert(m.indices.end(),
+                                 {v(x, z), v(x + 1, z), v(x + 1, z + 1), v(x, z), v(x + 1, z + 1), v(x, z + 1)});
             } else {
-                m.indices.insert(m.indices.end(), {v(x, z), v(x + 1, z), v(x, z + 1), v(x + 1, z), v(x + 1, z + 1), v(x, z + 1)});
+                m.indices.insert(m.indices.end(),
+                                 {v(x, z), v(x + 1, z), v(x, z + 1), v(x + 1, z), v(x + 1, z + 1), v(x, z + 1)});
             }
         }
     m.computeNormals();
@@ -57,7 +59,8 @@ inline Mesh uvSphere(Vec3f c, float r, int seg) {
     for (int i = 0; i <= seg; ++i)
         for (int j = 0; j < 2 * seg; ++j) {
             const float th = 3.14159265f * float(i) / float(seg), ph = 3.14159265f * float(j) / float(seg);
-            m.positions.push_back(c + Vec3f(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)) * r);
+            m.positions.push_back(c +
+                                  Vec3f(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)) * r);
         }
     auto v = [seg](int i, int j) { return uint32_t(i * 2 * seg + (j % (2 * seg))); };
     for (int i = 0; i < seg; ++i)

@@ -19,8 +19,8 @@ using namespace rtfact;
 namespace {
 
 template <int N>
-std::vector<float> render(const MeshScene<BVH<Triangle>>& scene, const PathIntegrator& integ, const CameraFrame& f, int w,
-                          int h, int spp) {
+std::vector<float> render(const MeshScene<BVH<Triangle>>& scene, const PathIntegrator& integ, const CameraFrame& f,
+                          int w, int h, int spp) {
     const PinholeCamera cam(f, w, h);
     RGBAFramebuffer fb(w, h);
     RayTracingRenderer<JitteredSampler, PathIntegrator> r{{}, integ};
@@ -36,7 +36,8 @@ std::vector<float> render(const MeshScene<BVH<Triangle>>& scene, const PathInteg
 // path can return to the object (it is convex).
 Mesh flatCube() {
     Mesh m;
-    const Vec3f c[8] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
+    const Vec3f c[8] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                        {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
     const int f[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
     for (const auto& q : f) {
         const uint32_t b = uint32_t(m.positions.size());
@@ -104,11 +105,11 @@ std::shared_ptr<Mesh> cornell() {
     light.kd = Vec3f(0.0f);
     light.ke = Vec3f(12.0f);
     m->materials = {white, red, green, light};
-    quad({-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}, 0);   // floor
-    quad({-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, 0);       // ceiling
-    quad({-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1}, 0);   // back
-    quad({-1, -1, -1}, {-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, 1);   // left
-    quad({1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}, 2);       // right
+    quad({-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}, 0);                                      // floor
+    quad({-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, 0);                                          // ceiling
+    quad({-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1}, 0);                                      // back
+    quad({-1, -1, -1}, {-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, 1);                                      // left
+    quad({1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}, 2);                                          // right
     quad({-0.3f, 0.99f, -0.3f}, {-0.3f, 0.99f, 0.3f}, {0.3f, 0.99f, 0.3f}, {0.3f, 0.99f, -0.3f}, 3);  // lamp
     // A block.
     const float x0 = -0.5f, x1 = 0.0f, z0 = -0.6f, z1 = -0.1f, y0 = -1.0f, y1 = -0.2f;

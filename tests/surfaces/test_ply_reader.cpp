@@ -141,12 +141,14 @@ std::string gridQuadFile(const std::string& name, int w, int h, bool bumpy) {
     ply.header("property list uint8 uint32 vertex_index");
     writeGridVertexData(ply, w, h, bumpy);
     for (int y = 0; y + 1 < h; ++y)
-        for (int x = 0; x + 1 < w; ++x) ply.list("uint8", "uint32", {y * w + x, y * w + x + 1, (y + 1) * w + x + 1, (y + 1) * w + x});
+        for (int x = 0; x + 1 < w; ++x)
+            ply.list("uint8", "uint32", {y * w + x, y * w + x + 1, (y + 1) * w + x + 1, (y + 1) * w + x});
     return ply.write(name);
 }
 
 Vec3f faceNormal(const Mesh& m, size_t t) {
-    const Vec3f a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]], c = m.positions[m.indices[3 * t + 2]];
+    const Vec3f a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
+                c = m.positions[m.indices[3 * t + 2]];
     return cross(b - a, c - a);
 }
 
@@ -170,8 +172,8 @@ void expectError(const std::string& path, const std::string& needle) {
 TEST(PlyStrips, ExactTrianglesInEveryFormatAndListType) {
     const std::vector<int> strip = {3, 0, 4, 1, -1, 4, 1, 5, 2, -1, 0, 0, 1, 3};
     const std::vector<uint32_t> expected = {3, 0, 4, 4, 0, 1, 4, 1, 5, 5, 1, 2, 1, 0, 3};
-    const std::pair<const char*, const char*> types[] = {
-        {"int", "int"}, {"uchar", "int"}, {"uint8", "int32"}, {"uint32", "uint32"}, {"ushort", "uint"}, {"int16", "short"}};
+    const std::pair<const char*, const char*> types[] = {{"int", "int"},       {"uchar", "int"},   {"uint8", "int32"},
+                                                         {"uint32", "uint32"}, {"ushort", "uint"}, {"int16", "short"}};
     for (const char* format : kFormats)
         for (const auto& [countType, itemType] : types) {
             PlyWriter ply(format);
@@ -181,7 +183,8 @@ TEST(PlyStrips, ExactTrianglesInEveryFormatAndListType) {
             ply.header(std::string("property list ") + countType + " " + itemType + " vertex_indices");
             writeGridVertexData(ply, 3, 2, false);
             ply.list(countType, itemType, strip);
-            const std::string path = ply.write(std::string("exact_") + format + "_" + countType + "_" + itemType + ".ply");
+            const std::string path =
+                ply.write(std::string("exact_") + format + "_" + countType + "_" + itemType + ".ply");
             SCOPED_TRACE(path);
             EXPECT_EQ(meshFileKind(path), MeshFileKind::Ply);
             const Mesh m = loadMesh(path);
@@ -238,7 +241,8 @@ TEST(PlyStrips, StripMeshRendersLikeFaceMesh) {
     constexpr int w = 24, h = 18, kW = 80, kH = 60;
     auto render = [&](const std::string& path) {
         const MeshScene<BVH<Triangle>> scene(std::make_shared<const Mesh>(loadMesh(path)));
-        const PinholeCamera cam(fitCamera(scene.bounds(), 45.0f, float(kW) / float(kH), {0.3f, -0.8f, 1.0f}, {0, 0, 1}), kW, kH);
+        const PinholeCamera cam(fitCamera(scene.bounds(), 45.0f, float(kW) / float(kH), {0.3f, -0.8f, 1.0f}, {0, 0, 1}),
+                                kW, kH);
         RGBAFramebuffer fb(kW, kH);
         DirectLightIntegrator integ;
         integ.lights = {PointLight{{30.0f, -10.0f, 25.0f}, Vec3f(2000.0f)}};
@@ -254,8 +258,8 @@ TEST(PlyStrips, StripMeshRendersLikeFaceMesh) {
     ASSERT_GT(lit / (kW * kH), 0.05) << "the reference image is dark: the test would compare nothing";
     for (const char* format : kFormats)
         for (const char* itemType : {"int", "uint32"}) {
-            const std::string path = gridStripFile(std::string("bumpy_") + format + "_" + itemType + ".ply", format, w, h,
-                                                   true, "uint32", itemType);
+            const std::string path = gridStripFile(std::string("bumpy_") + format + "_" + itemType + ".ply", format, w,
+                                                   h, true, "uint32", itemType);
             SCOPED_TRACE(path);
             const std::vector<float> strips = render(path);
             ASSERT_EQ(strips.size(), faces.size());
@@ -286,7 +290,8 @@ TEST(PlyStrips, BadStripsGiveOneLineErrors) {
         const std::string f = format;
         expectError(stripFile("range_" + f + ".ply", f, {3, 0, 4, 9}), "tristrips 0 entry 3 refers to vertex 9 of 6");
         expectError(stripFile("negative_" + f + ".ply", f, {3, 0, 4, -2}), "refers to vertex -2 of 6");
-        expectError(stripFile("count_" + f + ".ply", f, {3, 0, 4, 1}, 2000000000), "truncated or corrupt PLY data: tristrips 0 lists 2000000000 values");
+        expectError(stripFile("count_" + f + ".ply", f, {3, 0, 4, 1}, 2000000000),
+                    "truncated or corrupt PLY data: tristrips 0 lists 2000000000 values");
         expectError(stripFile("cut_" + f + ".ply", f, {3, 0, 4, 1, 5, 2}, INT_MIN, f == "ascii" ? 4 : 8), "truncated");
     }
     expectError(stripFile("negcount.ply", "ascii", {3, 0, 4}, -5), "tristrips 0: bad list length -5");

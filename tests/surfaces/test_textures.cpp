@@ -37,8 +37,8 @@ TEST(Textures, ImageBilinear) {
     const ImageTexture t{im};
     EXPECT_NEAR(t.sample(0.25f, 0.5f).x, 0.0f, 1e-6f);  // texel centre
     EXPECT_NEAR(t.sample(0.75f, 0.5f).x, 1.0f, 1e-6f);
-    EXPECT_NEAR(t.sample(0.5f, 0.5f).x, 0.5f, 1e-6f);   // half way
-    EXPECT_NEAR(t.sample(0.0f, 0.5f).x, 0.5f, 1e-6f);   // wraps around
+    EXPECT_NEAR(t.sample(0.5f, 0.5f).x, 0.5f, 1e-6f);  // half way
+    EXPECT_NEAR(t.sample(0.0f, 0.5f).x, 0.5f, 1e-6f);  // wraps around
 }
 
 TEST(Textures, ObjDiffuseMapColoursTheSurface) {
@@ -47,8 +47,9 @@ TEST(Textures, ObjDiffuseMapColoursTheSurface) {
     // 2x2 image: red, green / blue, white (top row first).
     writeImage(dir + "/tex.png", 2, 2, {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1});
     std::ofstream(dir + "/quad.mtl") << "newmtl t\nKd 1 1 1\nmap_Kd tex.png\n";
-    std::ofstream(dir + "/quad.obj") << "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-                                        "usemtl t\nf 1/1 2/2 3/3 4/4\n";
+    std::ofstream(dir + "/quad.obj")
+        << "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+           "usemtl t\nf 1/1 2/2 3/3 4/4\n";
     auto mesh = std::make_shared<const Mesh>(loadMesh(dir + "/quad.obj"));
     const MeshScene<BVH<Triangle>> scene(mesh);
     // Rays at the centres of the four texels (uv = 0.25/0.75).
@@ -103,8 +104,10 @@ TEST(Textures, HostileImagesAreOneLineErrorsNamingTheImage) {
     for (const Case& c : cases) {
         const std::string img = dir + "/" + c.name;
         fs::remove_all(img);
-        if (c.directory) fs::create_directories(img);
-        else if (c.name != "missing.png") std::ofstream(img, std::ios::binary) << c.bytes;
+        if (c.directory)
+            fs::create_directories(img);
+        else if (c.name != "missing.png")
+            std::ofstream(img, std::ios::binary) << c.bytes;
         std::ofstream(dir + "/quad.mtl") << "newmtl t\nKd 1 1 1\nmap_Kd " << c.name << "\n";
         std::ofstream(dir + "/quad.obj") << "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
                                             "usemtl t\nf 1/1 2/2 3/3\n";

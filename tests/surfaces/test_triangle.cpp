@@ -19,7 +19,9 @@ struct RefHit {
 
 // Möller-Trumbore in double precision, two-sided.
 RefHit reference(const Triangle& tri, Vec3f of, Vec3f df) {
-    auto sub = [](const double* a, const double* b, double* r) { for (int i = 0; i < 3; ++i) r[i] = a[i] - b[i]; };
+    auto sub = [](const double* a, const double* b, double* r) {
+        for (int i = 0; i < 3; ++i) r[i] = a[i] - b[i];
+    };
     auto crs = [](const double* a, const double* b, double* r) {
         r[0] = a[1] * b[2] - a[2] * b[1];
         r[1] = a[2] * b[0] - a[0] * b[2];
@@ -91,7 +93,8 @@ void checkEdges(bool commonOrigin) {
     const Mesh m = test::heightField(8, 3);
     std::vector<Triangle> tris;
     for (size_t t = 0; t < m.triangles(); ++t)
-        tris.push_back({m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]});
+        tris.push_back(
+            {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]});
     std::mt19937 rng(11 + N);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     std::vector<Vec3f> targets;
@@ -122,7 +125,8 @@ void checkEdges(bool commonOrigin) {
         hit.t = r.tMax;
         hit.id = Packet<N, int32_t>(-1);
         hit.u = hit.v = Packet<N>(0.0f);
-        for (size_t t = 0; t < tris.size(); ++t) isect.template intersect<HitData::Shading>(tris[t], uint32_t(t), r, hit, 0);
+        for (size_t t = 0; t < tris.size(); ++t)
+            isect.template intersect<HitData::Shading>(tris[t], uint32_t(t), r, hit, 0);
         for (int i = 0; i < N; ++i) {
             ++rays;
             if (hit.id[i] < 0) {

@@ -8,14 +8,14 @@
 #include <random>
 
 #include "core/accel/sah_bvh_builder.h"
+#include "core/accel/wide_bvh_intersector.h"
+#include "core/geometry/sphere.h"
+#include "core/render/ao_integrator.h"
 #include "core/render/framebuffer.h"
 #include "core/render/pinhole_camera.h"
 #include "core/render/pixel_center_sampler.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/render/tile_scheduler.h"
-#include "core/accel/wide_bvh_intersector.h"
-#include "core/geometry/sphere.h"
-#include "core/render/ao_integrator.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/path_integrator.h"
 #include "test_meshes.h"
@@ -45,8 +45,10 @@ std::vector<Triangle> testTriangles() {
 
 template <class Elem>
 auto elemIsect() {
-    if constexpr (std::is_same_v<Elem, Sphere>) return SphereIntersector{};
-    else return TriangleIntersector{};
+    if constexpr (std::is_same_v<Elem, Sphere>)
+        return SphereIntersector{};
+    else
+        return TriangleIntersector{};
 }
 
 bool inside(const AABB& in, const AABB& out) {
@@ -89,8 +91,10 @@ void checkStructure(const std::vector<Elem>& elems) {
         // Greedy collapse fills nodes unless it runs out of inner children to open.
         EXPECT_GE(used, ni == 0 && bin.nodes[0].isLeaf() ? 1 : 2);
     }
-    for (size_t i = 0; i < seen.size(); ++i) ASSERT_EQ(seen[i], 1) << "element " << i << " reached " << seen[i] << " times";
-    for (size_t i = 0; i < visits.size(); ++i) ASSERT_EQ(visits[i], 1) << "node " << i << " reached " << visits[i] << " times";
+    for (size_t i = 0; i < seen.size(); ++i)
+        ASSERT_EQ(seen[i], 1) << "element " << i << " reached " << seen[i] << " times";
+    for (size_t i = 0; i < visits.size(); ++i)
+        ASSERT_EQ(visits[i], 1) << "node " << i << " reached " << visits[i] << " times";
     // Collapsing a k-ary tree cuts the node count roughly by K / 2 at least.
     EXPECT_LT(w.nodes.size() * 2, bin.nodes.size());
 }
@@ -111,7 +115,8 @@ void checkTraversal(const std::vector<Elem>& elems, bool commonOrigin) {
             typename EI::template Hit<1> h;
             h.t = r.tMax;
             h.id = -1;
-            for (size_t i = 0; i < elems.size(); ++i) EI{}.template intersect<HitData::Distance>(elems[i], uint32_t(i), r, h, 0);
+            for (size_t i = 0; i < elems.size(); ++i)
+                EI{}.template intersect<HitData::Distance>(elems[i], uint32_t(i), r, h, 0);
             return std::pair<float, int>{int32_t(h.id) >= 0 ? float(h.t) : kInfinity, int32_t(h.id)};
         };
         for (int p = 0; p < packets; ++p) {
@@ -130,8 +135,10 @@ void checkTraversal(const std::vector<Elem>& elems, bool commonOrigin) {
             if (p % 3 == 1)
                 for (int i = 0; i < N; ++i) active.set(i, u01(rng) < 0.6f);
             typename EI::template Hit<N> hit;
-            if (rays.commonOrigin) isect.template intersect<true, HitData::Shading>(w, rays, hit, active);
-            else isect.template intersect<false, HitData::Shading>(w, rays, hit, active);
+            if (rays.commonOrigin)
+                isect.template intersect<true, HitData::Shading>(w, rays, hit, active);
+            else
+                isect.template intersect<false, HitData::Shading>(w, rays, hit, active);
             for (int i = 0; i < N; ++i) {
                 if (!active[i]) {
                     EXPECT_EQ(hit.id[i], -1) << "inactive lane " << i << " reported a hit";
@@ -196,15 +203,15 @@ TEST(WideBVH, SingleElementAndEmpty) {
     EXPECT_FALSE(WideBVHIntersector<SphereIntersector>{}.occluded<false>(none, r, Mask<1>(true))[0]);
 }
 
-#define RTFACT_WIDE_TESTS(Name, Elem, elems, K)                                                          \
-    TEST(WideBVH, Name##K##Single) {                                                                     \
-        checkTraversal<Elem, K, 1>(elems, true);                                                         \
-        checkTraversal<Elem, K, 1>(elems, false);                                                        \
-    }                                                                                                    \
-    TEST(WideBVH, Name##K##Native) {                                                                     \
-        checkTraversal<Elem, K, simd::kNativeWidth>(elems, true);                                        \
-        checkTraversal<Elem, K, simd::kNativeWidth>(elems, false);                                       \
-    }                                                                                                    \
+#define RTFACT_WIDE_TESTS(Name, Elem, elems, K)                    \
+    TEST(WideBVH, Name##K##Single) {                               \
+        checkTraversal<Elem, K, 1>(elems, true);                   \
+        checkTraversal<Elem, K, 1>(elems, false);                  \
+    }                                                              \
+    TEST(WideBVH, Name##K##Native) {                               \
+        checkTraversal<Elem, K, simd::kNativeWidth>(elems, true);  \
+        checkTraversal<Elem, K, simd::kNativeWidth>(elems, false); \
+    }                                                              \
     TEST(WideBVH, Name##K##Packet64) { checkTraversal<Elem, K, 64>(elems, false); }
 
 RTFACT_WIDE_TESTS(Spheres, Sphere, testSpheres(2000), 8)
@@ -232,7 +239,8 @@ TEST(WideBVH, MeshSceneIncoherentMatchesPacket) {
         rays.finalize();
         const auto hp = scene.intersect<N>(rays, Mask<N>(true));
         const auto hw = scene.intersectIncoherent<N>(rays, Mask<N>(true));
-        const Mask<N> op = scene.occluded<N>(rays, Mask<N>(true)), ow = scene.occludedIncoherent<N>(rays, Mask<N>(true));
+        const Mask<N> op = scene.occluded<N>(rays, Mask<N>(true)),
+                      ow = scene.occludedIncoherent<N>(rays, Mask<N>(true));
         for (int i = 0; i < N; ++i) {
             ASSERT_EQ(hp.id[i] >= 0, hw.id[i] >= 0) << "packet " << p << " lane " << i;
             EXPECT_EQ(op[i], ow[i]);

@@ -47,7 +47,8 @@ TEST(TransferFunction, WindowLevelAndHounsfield) {
 }
 
 TEST(TransferFunction, OpacityCorrectedForStep) {
-    const TransferFunction tf = parseTransferFunctionJson(R"({"colors":[[0,1,1,1],[1,1,1,1]],"opacity":[[0,0.3],[1,0.3]]})", "c");
+    const TransferFunction tf =
+        parseTransferFunctionJson(R"({"colors":[[0,1,1,1],[1,1,1,1]],"opacity":[[0,0.3],[1,0.3]]})", "c");
     for (float step : {0.25f, 0.5f, 1.0f, 2.0f}) {
         const TFTable t = buildTable(tf, {0.0f, 1.0f}, step, 256);
         // n steps of size `step` must attenuate like n*step voxels of size 1
@@ -57,7 +58,8 @@ TEST(TransferFunction, OpacityCorrectedForStep) {
 
 TEST(TransferFunction, VisibilityRangeQuery) {
     const TransferFunction tf = parseTransferFunctionJson(
-        R"({"space":"data","colors":[[0,1,1,1],[100,1,1,1]],"opacity":[[0,0],[40,0],[41,0.5],[60,0.5],[61,0],[100,0]]})", "v");
+        R"({"space":"data","colors":[[0,1,1,1],[100,1,1,1]],"opacity":[[0,0],[40,0],[41,0.5],[60,0.5],[61,0],[100,0]]})",
+        "v");
     const TFTable t = buildTable(tf, {0, 0}, 0.5f, 1024);
     EXPECT_FALSE(t.visible(0.0f, 39.5f));
     EXPECT_TRUE(t.visible(0.0f, 45.0f));
@@ -69,27 +71,29 @@ TEST(TransferFunction, VisibilityRangeQuery) {
 TEST(TransferFunction, ParaViewPreset) {
     const TransferFunction tf = parseTransferFunctionJson(R"([{"ColorSpace":"Diverging","Name":"Cool to Warm",
         "RGBPoints":[-1,0.23,0.299,0.754, 0,0.865,0.865,0.865, 1,0.706,0.016,0.15],
-        "Points":[-1,0,0.5,0, 1,0.8,0.5,0]}])", "pv.json");
+        "Points":[-1,0,0.5,0, 1,0.8,0.5,0]}])",
+                                                          "pv.json");
     EXPECT_EQ(tf.name, "Cool to Warm");
     ASSERT_EQ(tf.colors.size(), 3u);
     EXPECT_FLOAT_EQ(tf.colors[1].x, 0.5f);  // rescaled to [0, 1]
     EXPECT_NEAR(tf.alpha(0.5f), 0.4f, 1e-6f);
     // colour map only: a default opacity ramp
-    const TransferFunction c = parseTransferFunctionJson(R"({"Name":"gray","RGBPoints":[0,0,0,0,255,1,1,1]})", "pv2.json");
+    const TransferFunction c =
+        parseTransferFunctionJson(R"({"Name":"gray","RGBPoints":[0,0,0,0,255,1,1,1]})", "pv2.json");
     EXPECT_GT(c.alpha(1.0f), 0.0f);
 }
 
 TEST(TransferFunction, BadJsonGivesOneLineError) {
     const char* bad[] = {
-        "{",                                                                  // not JSON
-        "[]",                                                                 // empty array
-        R"({"colors":[[0,1,1,1]]})",                                          // no opacity
-        R"({"colors":[[0,1,1]],"opacity":[[0,1]]})",                          // short colour point
-        R"({"colors":[[1,1,1,1],[0,1,1,1]],"opacity":[[0,1]]})",              // unsorted
-        R"({"colors":[[0,2,1,1]],"opacity":[[0,1]]})",                        // colour out of range
-        R"({"colors":[[0,1,1,1]],"opacity":[[0,"a"]]})",                      // not a number
-        R"({"colors":[[0,1,1,1]],"opacity":[[0,1]],"space":"weird"})",        // bad space
-        R"({"RGBPoints":[0,1,1]})",                                           // ParaView, bad length
+        "{",                                                            // not JSON
+        "[]",                                                           // empty array
+        R"({"colors":[[0,1,1,1]]})",                                    // no opacity
+        R"({"colors":[[0,1,1]],"opacity":[[0,1]]})",                    // short colour point
+        R"({"colors":[[1,1,1,1],[0,1,1,1]],"opacity":[[0,1]]})",        // unsorted
+        R"({"colors":[[0,2,1,1]],"opacity":[[0,1]]})",                  // colour out of range
+        R"({"colors":[[0,1,1,1]],"opacity":[[0,"a"]]})",                // not a number
+        R"({"colors":[[0,1,1,1]],"opacity":[[0,1]],"space":"weird"})",  // bad space
+        R"({"RGBPoints":[0,1,1]})",                                     // ParaView, bad length
     };
     for (const char* s : bad) {
         try {

@@ -1,4 +1,4 @@
-// Loaders: formats round-trip, real data (skipped when /work/shared/datasets is absent),
+// Loaders: formats round-trip, real data (skipped when ../shared/datasets is absent),
 // and hostile inputs giving a one-line rtfact::Error instead of a crash or a huge
 // allocation.
 #include <fcntl.h>
@@ -156,11 +156,19 @@ TEST(VolumeIO, NrrdAttachedGzipAndDetachedSlices) {
     EXPECT_FLOAT_EQ(g.value(size_t(23)), 23.0f);
     // detached per-slice files: data file: sl.%d 1 4 1
     for (int k = 0; k < 4; ++k) writeFile("sl." + std::to_string(k + 1), data.substr(size_t(k) * 6, 6));
-    const VolumeGrid s = loadVolume(writeFile("d.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 3 4\nencoding: raw\ndata file: sl.%d 1 4 1\n"), quiet());
+    const VolumeGrid s = loadVolume(
+        writeFile("d.nhdr",
+                  "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 3 4\nencoding: raw\ndata file: sl.%d 1 4 1\n"),
+        quiet());
     EXPECT_EQ(std::memcmp(s.bytes.data(), data.data(), 24), 0);
     // Zero-padded slice numbers, as printf's %03d would write them.
-    for (int k = 0; k < 4; ++k) writeFile("pad" + std::string(k + 1 < 10 ? "00" : "0") + std::to_string(k + 1) + ".raw", data.substr(size_t(k) * 6, 6));
-    const VolumeGrid z = loadVolume(writeFile("p.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 3 4\nencoding: raw\ndata file: pad%03d.raw 1 4 1\n"), quiet());
+    for (int k = 0; k < 4; ++k)
+        writeFile("pad" + std::string(k + 1 < 10 ? "00" : "0") + std::to_string(k + 1) + ".raw",
+                  data.substr(size_t(k) * 6, 6));
+    const VolumeGrid z = loadVolume(
+        writeFile("p.nhdr",
+                  "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 3 4\nencoding: raw\ndata file: pad%03d.raw 1 4 1\n"),
+        quiet());
     EXPECT_EQ(std::memcmp(z.bytes.data(), data.data(), 24), 0);
 }
 
@@ -175,18 +183,32 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
     expectError([] { parseDims("10,10"); }, "X,Y,Z");
     // MetaImage: zero, overflowing and lying dims, bad type, missing data file
     const std::string raw = writeFile("m.raw", std::string(64, 'x'));
-    auto mhd = [&](const std::string& body) { return writeFile("m.mhd", "NDims = 3\n" + body + "ElementDataFile = m.raw\n"); };
+    auto mhd = [&](const std::string& body) {
+        return writeFile("m.mhd", "NDims = 3\n" + body + "ElementDataFile = m.raw\n");
+    };
     expectError([&] { loadVolume(mhd("DimSize = 0 4 4\nElementType = MET_UCHAR\n"), quiet()); }, "positive");
-    expectError([&] { loadVolume(mhd("DimSize = 4000000000 4000000000 4\nElementType = MET_UCHAR\n"), quiet()); }, "too large");
-    expectError([&] { loadVolume(mhd("DimSize = 1000 1000 1000\nElementType = MET_UCHAR\n"), quiet()); }, "size mismatch");
-    expectError([&] { loadVolume(mhd("DimSize = 4 4 4\nElementType = MET_BOGUS\n"), quiet()); }, "unsupported voxel type");
+    expectError([&] { loadVolume(mhd("DimSize = 4000000000 4000000000 4\nElementType = MET_UCHAR\n"), quiet()); },
+                "too large");
+    expectError([&] { loadVolume(mhd("DimSize = 1000 1000 1000\nElementType = MET_UCHAR\n"), quiet()); },
+                "size mismatch");
+    expectError([&] { loadVolume(mhd("DimSize = 4 4 4\nElementType = MET_BOGUS\n"), quiet()); },
+                "unsupported voxel type");
     expectError([&] { loadVolume(mhd("DimSize = 4 4 x\nElementType = MET_UCHAR\n"), quiet()); }, "DimSize");
     expectError([&] { loadVolume(writeFile("n.mhd", "NDims = 3\nDimSize = 4 4 4\n"), quiet()); }, "ElementDataFile");
     expectError([&] { loadVolume(mhd("DimSize = -4 4 4\nElementType = MET_UCHAR\n"), quiet()); }, "m.mhd");
-    expectError([&] { loadVolume(mhd("DimSize = 4 4 4\nElementSpacing = nan 1 1\nElementType = MET_UCHAR\n"), quiet()); }, "ElementSpacing");
-    expectError([&] { loadVolume(mhd("DimSize = 4 4 4\nElementSpacing = 1 inf 1\nElementType = MET_UCHAR\n"), quiet()); }, "ElementSpacing");
-    expectError([&] { loadVolume(writeFile("gone.mhd", "NDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\nElementDataFile = gone.raw\n"), quiet()); },
-                "gone.raw");
+    expectError(
+        [&] { loadVolume(mhd("DimSize = 4 4 4\nElementSpacing = nan 1 1\nElementType = MET_UCHAR\n"), quiet()); },
+        "ElementSpacing");
+    expectError(
+        [&] { loadVolume(mhd("DimSize = 4 4 4\nElementSpacing = 1 inf 1\nElementType = MET_UCHAR\n"), quiet()); },
+        "ElementSpacing");
+    expectError(
+        [&] {
+            loadVolume(writeFile("gone.mhd",
+                                 "NDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\nElementDataFile = gone.raw\n"),
+                       quiet());
+        },
+        "gone.raw");
     expectError([] { parseDims("-1,10,10"); }, "positive");
     {
         VolumeLoadOptions skip = o;
@@ -196,33 +218,93 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
     }
     // NRRD: bad magic, missing type, unsupported encoding, lying sizes, truncated gzip
     expectError([&] { loadVolume(writeFile("b1.nrrd", "NRRX0004\n"), quiet()); }, "NRRD000");
-    expectError([&] { loadVolume(writeFile("b2.nrrd", "NRRD0004\nsizes: 2 2 2\nencoding: raw\n\n01234567"), quiet()); }, "type");
-    expectError([&] { loadVolume(writeFile("b3.nrrd", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: bzip2\n\n01234567"), quiet()); }, "encoding");
-    expectError([&] { loadVolume(writeFile("b4.nrrd", "NRRD0004\ntype: uint8\nsizes: 1000 1000 1000\nencoding: raw\n\n0123"), quiet()); }, "size mismatch");
-    expectError([&] { loadVolume(writeFile("b5.nrrd", "NRRD0004\ntype: uint8\nsizes: 1000 1000 1000\nencoding: gzip\n\n" + gzip("abc")), quiet()); },
-                "cannot hold");
+    expectError([&] { loadVolume(writeFile("b2.nrrd", "NRRD0004\nsizes: 2 2 2\nencoding: raw\n\n01234567"), quiet()); },
+                "type");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b3.nrrd", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: bzip2\n\n01234567"),
+                       quiet());
+        },
+        "encoding");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b4.nrrd", "NRRD0004\ntype: uint8\nsizes: 1000 1000 1000\nencoding: raw\n\n0123"),
+                       quiet());
+        },
+        "size mismatch");
+    expectError(
+        [&] {
+            loadVolume(
+                writeFile("b5.nrrd", "NRRD0004\ntype: uint8\nsizes: 1000 1000 1000\nencoding: gzip\n\n" + gzip("abc")),
+                quiet());
+        },
+        "cannot hold");
     std::string data(4096, '\0');
     for (size_t i = 0; i < data.size(); ++i) data[i] = char(i * 7);
     const std::string gz = gzip(data);
-    expectError([&] { loadVolume(writeFile("b6.nrrd", "NRRD0004\ntype: uint8\nsizes: 16 16 16\nencoding: gzip\n\n" + gz.substr(0, gz.size() / 2)), quiet()); },
-                "truncated");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b6.nrrd", "NRRD0004\ntype: uint8\nsizes: 16 16 16\nencoding: gzip\n\n" +
+                                                gz.substr(0, gz.size() / 2)),
+                       quiet());
+        },
+        "truncated");
     std::string corrupt = gz;
     for (size_t i = 20; i < 60 && i < corrupt.size(); ++i) corrupt[i] = char(0xFF);
-    expectError([&] { loadVolume(writeFile("b7.nrrd", "NRRD0004\ntype: uint8\nsizes: 16 16 16\nencoding: gzip\n\n" + corrupt), quiet()); }, "");
-    expectError([&] { loadVolume(writeFile("b8.nrrd", "NRRD0004\ntype: uint8\nsizes: 0 2 2\nencoding: raw\n\n01234567"), quiet()); }, "b8.nrrd");
-    expectError([&] { loadVolume(writeFile("b9.nrrd", "NRRD0004\ntype: uint8\nsizes: 4000000000 4000000000 4000000000\nencoding: raw\n\n0"), quiet()); },
-                "b9.nrrd");
-    expectError([&] { loadVolume(writeFile("b10.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: nowhere.raw\n"), quiet()); },
-                "nowhere.raw");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b7.nrrd", "NRRD0004\ntype: uint8\nsizes: 16 16 16\nencoding: gzip\n\n" + corrupt),
+                       quiet());
+        },
+        "");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b8.nrrd", "NRRD0004\ntype: uint8\nsizes: 0 2 2\nencoding: raw\n\n01234567"), quiet());
+        },
+        "b8.nrrd");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b9.nrrd",
+                                 "NRRD0004\ntype: uint8\nsizes: 4000000000 4000000000 4000000000\nencoding: raw\n\n0"),
+                       quiet());
+        },
+        "b9.nrrd");
+    expectError(
+        [&] {
+            loadVolume(
+                writeFile("b10.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: nowhere.raw\n"),
+                quiet());
+        },
+        "nowhere.raw");
     // Found by fuzz_volume_headers: the slice pattern went to printf ("%s" crashed).
-    expectError([&] { loadVolume(writeFile("b12.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%s 1 2 1\n"), quiet()); },
-                "one %d expected");
-    expectError([&] { loadVolume(writeFile("b13.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%d.%d 1 2 1\n"), quiet()); },
-                "one %d expected");
-    expectError([&] { loadVolume(writeFile("b14.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%d 1 1e300 1\n"), quiet()); },
-                "data file max");
-    expectError([&] { loadVolume(writeFile("b11.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: gone.%d 1 2 1\n"), quiet()); },
-                "gone.");
+    expectError(
+        [&] {
+            loadVolume(
+                writeFile("b12.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%s 1 2 1\n"),
+                quiet());
+        },
+        "one %d expected");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b13.nhdr",
+                                 "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%d.%d 1 2 1\n"),
+                       quiet());
+        },
+        "one %d expected");
+    expectError(
+        [&] {
+            loadVolume(writeFile("b14.nhdr",
+                                 "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: sl.%d 1 1e300 1\n"),
+                       quiet());
+        },
+        "data file max");
+    expectError(
+        [&] {
+            loadVolume(
+                writeFile("b11.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: gone.%d 1 2 1\n"),
+                quiet());
+        },
+        "gone.");
     // NIfTI written on a big-endian machine (byte-swapped header) whose dims lie.
     {
         std::string be = niftiHeader(16, 16, 16, 2, 8);
@@ -259,7 +341,13 @@ TEST(VolumeIO, MalformedInputsGiveClearErrors) {
     expectError([&] { loadVolume(writeFile("g.vdb", std::string(1000, 'z')), quiet()); }, "OpenVDB");
     expectError([&] { loadVolume(writeFile("e.vdb", ""), quiet()); }, "OpenVDB");
     // VTI / DICOM
-    expectError([&] { loadVolume(writeFile("x.vti", "<VTKFile type=\"ImageData\"><ImageData WholeExtent=\"0 99999 0 99999 0 99999\""), quiet()); }, "");
+    expectError(
+        [&] {
+            loadVolume(
+                writeFile("x.vti", "<VTKFile type=\"ImageData\"><ImageData WholeExtent=\"0 99999 0 99999 0 99999\""),
+                quiet());
+        },
+        "");
     fs::create_directories(tmpDir() + "/emptydicom");
     expectError([&] { loadVolume(tmpDir() + "/emptydicom", quiet()); }, "DICOM");
     // A file with the DICM marker and garbage after it: VTK's complaints become one line.
@@ -370,14 +458,16 @@ TEST(VolumeIO, GzipStreamsMustEndWithAValidTrailer) {
         for (size_t k = 1; k <= 8; ++k) cuts.push_back(gz.size() - k);
         for (size_t cut : cuts) {
             const std::string name = "cut" + std::to_string(n++) + c.ext;
-            expectError([&] { loadVolume(writeFile(name, c.head + gz.substr(0, cut)), quiet()); }, name + ": truncated");
+            expectError([&] { loadVolume(writeFile(name, c.head + gz.substr(0, cut)), quiet()); },
+                        name + ": truncated");
         }
         // wrong CRC (first trailer byte), wrong length (last)
         for (size_t at : {gz.size() - 8, gz.size() - 1}) {
             std::string bad = gz;
             bad[at] = char(bad[at] ^ 0x5A);
             const std::string name = "badtrailer" + std::to_string(n++) + c.ext;
-            expectError([&] { loadVolume(writeFile(name, c.head + bad), quiet()); }, name + ": corrupt compressed data");
+            expectError([&] { loadVolume(writeFile(name, c.head + bad), quiet()); },
+                        name + ": corrupt compressed data");
         }
         // Two members (as `cat a.gz b.gz` makes) and zero padding after the stream load;
         // other bytes after it do not.
@@ -386,24 +476,31 @@ TEST(VolumeIO, GzipStreamsMustEndWithAValidTrailer) {
         const std::string twoMembers = gzip(raw.substr(0, half)) + gzip(raw.substr(half));
         const VolumeGrid two = loadVolume(writeFile("two" + std::string(c.ext), c.head + twoMembers), quiet());
         EXPECT_EQ(std::memcmp(two.bytes.data(), data.data(), data.size()), 0) << c.ext;
-        EXPECT_NO_THROW(loadVolume(writeFile("padded" + std::string(c.ext), c.head + gz + std::string(100, '\0')), quiet()));
+        EXPECT_NO_THROW(
+            loadVolume(writeFile("padded" + std::string(c.ext), c.head + gz + std::string(100, '\0')), quiet()));
         const std::string junk = "junk" + std::string(c.ext);
-        expectError([&] { loadVolume(writeFile(junk, c.head + gz + std::string(4, '\0') + "junk"), quiet()); }, junk + ": ");
+        expectError([&] { loadVolume(writeFile(junk, c.head + gz + std::string(4, '\0') + "junk"), quiet()); },
+                    junk + ": ");
     }
     // MetaImage CompressedData is a zlib stream: its Adler-32 trailer is checked the same way.
     {
         uLongf len = compressBound(uLong(data.size()));
         std::string z(len, '\0');
-        ASSERT_EQ(compress2(reinterpret_cast<Bytef*>(z.data()), &len, reinterpret_cast<const Bytef*>(data.data()), uLong(data.size()), 6), Z_OK);
+        ASSERT_EQ(compress2(reinterpret_cast<Bytef*>(z.data()), &len, reinterpret_cast<const Bytef*>(data.data()),
+                            uLong(data.size()), 6),
+                  Z_OK);
         z.resize(len);
-        const std::string head = "NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\nCompressedData = True\nElementDataFile = LOCAL\n";
+        const std::string head =
+            "NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\nCompressedData = True\nElementDataFile = LOCAL\n";
         const VolumeGrid ok = loadVolume(writeFile("z.mha", head + z), quiet());
         EXPECT_EQ(std::memcmp(ok.bytes.data(), data.data(), data.size()), 0);
         for (size_t k = 1; k <= 4; ++k)
-            expectError([&] { loadVolume(writeFile("zcut.mha", head + z.substr(0, z.size() - k)), quiet()); }, "zcut.mha: truncated");
+            expectError([&] { loadVolume(writeFile("zcut.mha", head + z.substr(0, z.size() - k)), quiet()); },
+                        "zcut.mha: truncated");
         std::string bad = z;
         bad.back() = char(bad.back() ^ 1);
-        expectError([&] { loadVolume(writeFile("zbad.mha", head + bad), quiet()); }, "zbad.mha: corrupt compressed data");
+        expectError([&] { loadVolume(writeFile("zbad.mha", head + bad), quiet()); },
+                    "zbad.mha: corrupt compressed data");
     }
 }
 
@@ -451,43 +548,82 @@ std::string makeFifo(const std::string& name) {
 TEST(VolumeIO, NamedPipesAreRejectedWithoutOpeningThem) {
     for (const char* ext : {".mhd", ".mha", ".nrrd", ".nhdr", ".nii", ".nii.gz", ".vti", ".vdb", "_8x8x8_uint8.raw"}) {
         const std::string p = makeFifo(std::string("pipe") + ext);
-        expectFifoRejected(p, [&] { loadVolume(p, quiet()); }, std::string("loadVolume ") + ext);
-        expectFifoRejected(p, [&] { loadBrickedVolume(p, quiet()); }, std::string("loadBrickedVolume ") + ext);
+        expectFifoRejected(
+            p, [&] { loadVolume(p, quiet()); }, std::string("loadVolume ") + ext);
+        expectFifoRejected(
+            p, [&] { loadBrickedVolume(p, quiet()); }, std::string("loadBrickedVolume ") + ext);
     }
     {
         const std::string p = makeFifo("pipe.bin");
         VolumeLoadOptions raw = quiet();
         raw.dims = std::array<int, 3>{2, 2, 2};
         raw.type = "u8";
-        expectFifoRejected(p, [&] { loadVolume(p, raw); }, "raw with --dims");
+        expectFifoRejected(
+            p, [&] { loadVolume(p, raw); }, "raw with --dims");
     }
     // the format readers called directly
     const std::string vdb = makeFifo("direct.vdb"), vti = makeFifo("direct.vti");
-    expectFifoRejected(vdb, [&] { loadVDB(vdb, quiet()); }, "loadVDB");
-    expectFifoRejected(vdb, [&] { loadVDBBricked(vdb, quiet()); }, "loadVDBBricked");
-    expectFifoRejected(vti, [&] { loadVTI(vti, quiet()); }, "loadVTI");
+    expectFifoRejected(
+        vdb, [&] { loadVDB(vdb, quiet()); }, "loadVDB");
+    expectFifoRejected(
+        vdb, [&] { loadVDBBricked(vdb, quiet()); }, "loadVDBBricked");
+    expectFifoRejected(
+        vti, [&] { loadVTI(vti, quiet()); }, "loadVTI");
     // detached data files: MetaImage, NRRD (single file, slice pattern, LIST, line skip)
     const std::string data = makeFifo("pipedata.raw");
-    expectFifoRejected(data, [&] {
-        loadVolume(writeFile("det.mhd", "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\nElementDataFile = pipedata.raw\n"), quiet());
-    }, "MetaImage data file");
-    expectFifoRejected(data, [&] {
-        loadVolume(writeFile("det.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: pipedata.raw\n"), quiet());
-    }, "NRRD data file");
-    expectFifoRejected(data, [&] {
-        loadVolume(writeFile("detgz.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: gzip\ndata file: pipedata.raw\n"), quiet());
-    }, "NRRD gzip data file");
-    expectFifoRejected(data, [&] {
-        loadVolume(writeFile("detskip.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\nline skip: 1\ndata file: pipedata.raw\n"), quiet());
-    }, "NRRD data file with line skip");
-    expectFifoRejected(data, [&] {
-        loadVolume(writeFile("detlist.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: LIST\npipedata.raw\n"), quiet());
-    }, "NRRD data file LIST");
+    expectFifoRejected(
+        data,
+        [&] {
+            loadVolume(
+                writeFile("det.mhd",
+                          "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\nElementDataFile = pipedata.raw\n"),
+                quiet());
+        },
+        "MetaImage data file");
+    expectFifoRejected(
+        data,
+        [&] {
+            loadVolume(
+                writeFile("det.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: pipedata.raw\n"),
+                quiet());
+        },
+        "NRRD data file");
+    expectFifoRejected(
+        data,
+        [&] {
+            loadVolume(writeFile("detgz.nhdr",
+                                 "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: gzip\ndata file: pipedata.raw\n"),
+                       quiet());
+        },
+        "NRRD gzip data file");
+    expectFifoRejected(
+        data,
+        [&] {
+            loadVolume(
+                writeFile(
+                    "detskip.nhdr",
+                    "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\nline skip: 1\ndata file: pipedata.raw\n"),
+                quiet());
+        },
+        "NRRD data file with line skip");
+    expectFifoRejected(
+        data,
+        [&] {
+            loadVolume(writeFile("detlist.nhdr",
+                                 "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: LIST\npipedata.raw\n"),
+                       quiet());
+        },
+        "NRRD data file LIST");
     const std::string slice = makeFifo("pipeslice.2");
     writeFile("pipeslice.1", std::string(4, 'x'));
-    expectFifoRejected(slice, [&] {
-        loadVolume(writeFile("detpat.nhdr", "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: pipeslice.%d 1 2 1\n"), quiet());
-    }, "NRRD slice pattern");
+    expectFifoRejected(
+        slice,
+        [&] {
+            loadVolume(writeFile("detpat.nhdr",
+                                 "NRRD0004\ntype: uint8\nsizes: 2 2 2\nencoding: raw\ndata file: pipeslice.%d 1 2 1\n"),
+                       quiet());
+        },
+        "NRRD slice pattern");
     // a DICOM directory holding a pipe: VTK's reader would open every file in it
     const std::string dir = tmpDir() + "/dicom_with_pipe";
     fs::remove_all(dir);
@@ -495,10 +631,14 @@ TEST(VolumeIO, NamedPipesAreRejectedWithoutOpeningThem) {
     writeFile("dicom_with_pipe/a.dcm", std::string(128, '\0') + "DICM" + std::string(600, '\x33'));
     const std::string dpipe = dir + "/b.dcm";
     ASSERT_EQ(::mkfifo(dpipe.c_str(), 0600), 0);
-    expectFifoRejected(dpipe, [&] { loadVolume(dir, quiet()); }, "DICOM directory");
+    expectFifoRejected(
+        dpipe, [&] { loadVolume(dir, quiet()); }, "DICOM directory");
     // --tf FILE.json and the DICOM modality reader
     const std::string tf = makeFifo("pipe_tf.json");
-    expectFifoRejected(tf, [&] { loadTransferFunction(tf); }, "loadTransferFunction");
-    expectFifoRejected(tf, [&] { resolveTransferFunction(tf); }, "resolveTransferFunction");
-    expectFifoRejected(dpipe, [&] { readDicomModality(dpipe); }, "readDicomModality");
+    expectFifoRejected(
+        tf, [&] { loadTransferFunction(tf); }, "loadTransferFunction");
+    expectFifoRejected(
+        tf, [&] { resolveTransferFunction(tf); }, "resolveTransferFunction");
+    expectFifoRejected(
+        dpipe, [&] { readDicomModality(dpipe); }, "readDicomModality");
 }

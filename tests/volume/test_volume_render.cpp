@@ -47,7 +47,8 @@ void checkTrilinear(VolumeGrid g, const std::function<float(float, float, float)
         Vec3f ref[kW];
         for (int i = 0; i < kW; ++i) {
             ref[i] = Vec3f(u(rng) * float(g.dims[0] - 1), u(rng) * float(g.dims[1] - 1), u(rng) * float(g.dims[2] - 1));
-            if (it == 0 && i == 0) ref[i] = Vec3f(float(g.dims[0] - 1), float(g.dims[1] - 1), float(g.dims[2] - 1));  // far corner
+            if (it == 0 && i == 0)
+                ref[i] = Vec3f(float(g.dims[0] - 1), float(g.dims[1] - 1), float(g.dims[2] - 1));  // far corner
             p.setLane(i, ref[i]);
         }
         const Packet<kW> v = VolumeIntegrator::sample<kW>(s, VolumeIntegrator::clampToGrid<kW>(s, p));
@@ -88,7 +89,8 @@ Rendered render(const VolumeGrid& g, const TransferFunction& tf, VolumeRenderSet
     if (rs.mode == VolumeMode::Iso) rs.iso = lo + 0.4f * (hi - lo);
     Rendered out{w, h, {}, 0, 0};
     withVolumeScene(bv, table, rs, [&](const auto& scene) {
-        const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, float(w) / float(h), {0.45f, -1.0f, 0.35f}, {0, 0, 1}), w, h);
+        const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, float(w) / float(h), {0.45f, -1.0f, 0.35f}, {0, 0, 1}),
+                                w, h);
         RGBAFramebuffer fb(w, h);
         const RayTracingRenderer<PixelCenterSampler, VolumeIntegrator> r{};
         RenderOptions ro;
@@ -155,8 +157,10 @@ TEST(VolumeDVR, SlabTransmittanceMatchesClosedForm) {
         for (int i = 0; i < kW; ++i) {
             const float T = 1.0f - r.alpha[i];
             const bool divides = std::fabs(d / step - std::round(d / step)) < 1e-4f;
-            if (divides) EXPECT_NEAR(T, exact, 1e-3f * exact) << "step " << step;
-            else EXPECT_LE(std::fabs(std::log(T) - std::log(exact)), sigma * step * 1.001f) << "step " << step;
+            if (divides)
+                EXPECT_NEAR(T, exact, 1e-3f * exact) << "step " << step;
+            else
+                EXPECT_LE(std::fabs(std::log(T) - std::log(exact)), sigma * step * 1.001f) << "step " << step;
         }
     }
 }
@@ -164,7 +168,8 @@ TEST(VolumeDVR, SlabTransmittanceMatchesClosedForm) {
 TEST(VolumeDVR, EmptySpaceSkippingChangesNoPixel) {
     const VolumeGrid ph = makeSheppLogan(64, Storage::U16);
     const TransferFunction tf = parseTransferFunctionJson(
-        R"({"colors":[[0,0.2,0.3,0.9],[1,1,0.9,0.8]],"opacity":[[0,0],[0.15,0],[0.2,0.05],[0.3,0.2],[0.5,0],[1,0]]})", "t");
+        R"({"colors":[[0,0.2,0.3,0.9],[1,1,0.9,0.8]],"opacity":[[0,0],[0.15,0],[0.2,0.05],[0.3,0.2],[0.5,0],[1,0]]})",
+        "t");
     for (VolumeMode m : {VolumeMode::DVR, VolumeMode::Shaded, VolumeMode::MIP}) {
         VolumeRenderSettings on, off;
         on.mode = off.mode = m;
@@ -214,7 +219,10 @@ TEST_P(ToothRegression, MatchesReference) {
     ASSERT_NO_THROW(tooth()) << "tracked dataset datasets/volumes/tooth_103x94x161_uint8.raw";
     const std::string mode = GetParam();
     VolumeRenderSettings rs;
-    rs.mode = mode == "shaded" ? VolumeMode::Shaded : mode == "mip" ? VolumeMode::MIP : mode == "iso" ? VolumeMode::Iso : VolumeMode::DVR;
+    rs.mode = mode == "shaded" ? VolumeMode::Shaded
+              : mode == "mip"  ? VolumeMode::MIP
+              : mode == "iso"  ? VolumeMode::Iso
+                               : VolumeMode::DVR;
     const TransferFunction tf = transferFunctionPreset(mode == "mip" ? "grayscale" : "ct-bone");
     const Rendered r = render<64>(tooth(), tf, rs, 160, 160);
     test::expectMatchesReference(std::string(RTFACT_TEST_DATA) + "/tooth_" + mode + ".png", r.w, r.h, r.rgba);
@@ -226,7 +234,8 @@ TEST(VolumeBricks, MatchDenseGridAndShareZeroBricks) {
     const BrickedVolume b = brickVolume(g);
     for (int k = 0; k < 37; ++k)
         for (int j = 0; j < 37; ++j)
-            for (int i = 0; i < 37; ++i) ASSERT_EQ(b.stored(i, j, k), g.stored(g.index(i, j, k))) << i << "," << j << "," << k;
+            for (int i = 0; i < 37; ++i)
+                ASSERT_EQ(b.stored(i, j, k), g.stored(g.index(i, j, k))) << i << "," << j << "," << k;
     EXPECT_LT(b.storedBricks(), b.brickCount());  // the air around the phantom shares brick 0
     EXPECT_LE(double(b.memoryBytes()), 1.5 * double(g.voxelCount() * 2) + 4096.0);
 }
