@@ -2,20 +2,18 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "core/io/mapped_file.h"
+#include "core/io/ply_header.h"
 #include "core/util/error.h"
 #include "fuzz/fuzz_file_input.h"
-#include "surfaces/mesh.h"
-#include "surfaces/ply_header.h"
-
-namespace rtfact {
-Mesh readPly(const std::string& file, const PlyHeader& h);  // surfaces/ply_reader.cpp
-}
+#include "surfaces/ply_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string path = rtfact::fuzz::writeTemp(data, size, ".ply");
     try {
-        const auto header = rtfact::readPlyHeader(path);
-        const auto mesh = rtfact::readPly(path, header);
+        const rtfact::io::MappedFile f(path);
+        const auto header = rtfact::io::readPlyHeader(f);
+        const auto mesh = rtfact::readPly(f, header);
         (void)mesh;
     } catch (const rtfact::Error&) {
     }

@@ -1,18 +1,11 @@
 // libFuzzer harness: our own point-cloud readers (PLY binary/ASCII, XYZ, PTS). The first
-// byte picks the format; the rest is the file.
+// byte picks the format; the rest is the file. PCD has its own harness (fuzz_pcd).
 #include <cstddef>
 #include <cstdint>
 
 #include "core/util/error.h"
 #include "fuzz/fuzz_file_input.h"
 #include "points/point_cloud_io.h"
-#include "points/point_cloud_io_detail.h"
-
-// PCD has its own harness (fuzz_pcd).
-namespace rtfact::points {
-PointCloud loadPcd(const std::string& file) { throw Error(file, "stub"); }
-std::optional<PointFileInfo> probePcd(const std::string& file) { throw Error(file, "stub"); }
-}  // namespace rtfact::points
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size < 1) return 0;

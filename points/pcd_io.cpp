@@ -37,16 +37,16 @@ int smallInt(const std::string& t) {
 }
 
 PcdHeader parsePcdHeader(const MappedFile& f) {
-    const std::string& file = f.name;
+    const std::string& file = f.name();
     PcdHeader h;
     size_t pos = 0;
     bool haveData = false;
-    while (pos < f.size && !haveData) {
+    while (pos < f.size() && !haveData) {
         size_t eol = pos;
-        while (eol < f.size && f.data[eol] != '\n') ++eol;
+        while (eol < f.size() && f.data()[eol] != '\n') ++eol;
         if (eol - pos > 65536) throw Error(file, "PCD header line too long (not a PCD file?)");
-        std::string line(f.data + pos, eol - pos);
-        pos = std::min(eol + 1, f.size);
+        std::string line(f.data() + pos, eol - pos);
+        pos = std::min(eol + 1, f.size());
         if (line.empty()) continue;
         if (line.back() == '\r') line.pop_back();
         // PCL ends its header at a line of blanks (e.g. "\r") and then reads the body with
@@ -152,9 +152,9 @@ size_t rowSize(const PcdHeader& h) {
 
 // The size checks PCL does not do.
 void validateBody(const MappedFile& f, const PcdHeader& h) {
-    const std::string& file = f.name;
+    const std::string& file = f.name();
     if (h.points == 0) throw Error(file, "empty point cloud (POINTS 0)");
-    const size_t remaining = f.size - h.bodyOffset;
+    const size_t remaining = f.size() - h.bodyOffset;
     const size_t row = rowSize(h);
     if (h.data == "ascii") {
         size_t values = 0;
@@ -162,8 +162,8 @@ void validateBody(const MappedFile& f, const PcdHeader& h) {
         if (h.points > remaining / (2 * values))
             throw Error(file, "PCD header declares " + std::to_string(h.points) + " points but the file is too small");
         // Every point is one line of exactly `values` tokens (PCL only warns and skips).
-        const char* p = f.data + h.bodyOffset;
-        const char* end = f.data + f.size;
+        const char* p = f.data() + h.bodyOffset;
+        const char* end = f.data() + f.size();
         for (uint64_t i = 0; i < h.points; ++i) {
             while (p < end && (*p == '\n' || *p == '\r')) ++p;  // PCL skips empty lines
             if (p == end)
@@ -188,8 +188,8 @@ void validateBody(const MappedFile& f, const PcdHeader& h) {
     } else {
         if (remaining < 8) throw Error(file, "PCD compressed body truncated (no size words)");
         uint32_t csize, usize;
-        std::memcpy(&csize, f.data + h.bodyOffset, 4);
-        std::memcpy(&usize, f.data + h.bodyOffset + 4, 4);
+        std::memcpy(&csize, f.data() + h.bodyOffset, 4);
+        std::memcpy(&usize, f.data() + h.bodyOffset + 4, 4);
         if (csize > remaining - 8)
             throw Error(file,
                         "PCD compressed block of " + std::to_string(csize) + " bytes runs past the end of the file");
@@ -271,7 +271,7 @@ std::vector<char> decodeRows(const std::string& file, const PcdHeader& h) {
     MappedFile f(file);
     const size_t n = size_t(h.points), row = rowSize(h);
     std::vector<char> rows(n * row);
-    const char* body = f.data + h.bodyOffset;
+    const char* body = f.data() + h.bodyOffset;
     if (h.data == "binary") {
         std::memcpy(rows.data(), body, n * row);
     } else if (h.data == "binary_compressed") {
@@ -290,7 +290,7 @@ std::vector<char> decodeRows(const std::string& file, const PcdHeader& h) {
     } else {
         // ASCII: one line per point, tokens in field order (validateBody counted them).
         const char* p = body;
-        const char* end = f.data + f.size;
+        const char* end = f.data() + f.size();
         std::string tok;
         for (size_t i = 0; i < n; ++i) {
             while (p < end && (*p == '\n' || *p == '\r')) ++p;
@@ -369,7 +369,7 @@ PointCloud loadPcd(const std::string& file) {
         const char* rec = rows.data() + i * row;
         // Separate R/G/B fields are skipped above: colour comes from the packed rgb only.
         for (const Slot& s : slots)
-            storeAttr(sink, i, s.attr, readScalar(rec + s.offset, s.type, false), s.type, hasN, false);
+            storeAttr(sink, i, s.attr, io::decodeScalar(rec + s.offset, s.type, false), s.type, hasN, false);
         if (rgbOffset >= 0) {
             uint32_t packed;  // 0x00RRGGBB whatever the declared type (F or U)
             std::memcpy(&packed, rec + rgbOffset, 4);

@@ -1,130 +1,24 @@
-// PLY reading and writing. The header is parsed and every count checked against the
-// file size before anything is allocated; binary bodies are decoded in parallel.
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
+// PLY reading and writing, and the point sink shared with the PCD and XYZ readers. The
+// header (core/io/ply_header.h) checks every count against the file size before anything
+// is allocated; binary bodies are decoded in parallel.
 #include <tbb/parallel_for.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
+#include "core/io/ply_header.h"
 #include "core/util/error.h"
-#include "core/util/input_file.h"
+#include "core/util/huge_pages.h"
 #include "core/util/memory_budget.h"
-#include "points/huge_pages.h"
 #include "points/point_cloud_io.h"
 #include "points/point_cloud_io_detail.h"
 
 namespace rtfact::points {
 namespace detail {
-
-MappedFile::MappedFile(const std::string& file) : name(file) {
-    requireRegularFile(file);  // open() itself would block on a named pipe without a writer
-    const int fd = ::open(file.c_str(), O_RDONLY);
-    if (fd < 0) throw Error(file, std::string("cannot open: ") + std::strerror(errno));
-    struct stat st {};
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        ::close(fd);
-        throw Error(file, "not a regular file");
-    }
-    size = size_t(st.st_size);
-    if (size > 0) {
-        void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
-        if (p == MAP_FAILED) {
-            ::close(fd);
-            throw Error(file, "cannot map file");
-        }
-        data = static_cast<const char*>(p);
-    }
-    ::close(fd);
-}
-MappedFile::~MappedFile() {
-    if (data) ::munmap(const_cast<char*>(data), size);
-}
-
-int typeSize(ScalarType t) {
-    switch (t) {
-        case ScalarType::I8:
-        case ScalarType::U8:
-            return 1;
-        case ScalarType::I16:
-        case ScalarType::U16:
-            return 2;
-        case ScalarType::I32:
-        case ScalarType::U32:
-        case ScalarType::F32:
-            return 4;
-        case ScalarType::F64:
-            return 8;
-    }
-    return 0;
-}
-
-std::optional<ScalarType> parseType(const std::string& s) {
-    if (s == "char" || s == "int8") return ScalarType::I8;
-    if (s == "uchar" || s == "uint8") return ScalarType::U8;
-    if (s == "short" || s == "int16") return ScalarType::I16;
-    if (s == "ushort" || s == "uint16") return ScalarType::U16;
-    if (s == "int" || s == "int32") return ScalarType::I32;
-    if (s == "uint" || s == "uint32") return ScalarType::U32;
-    if (s == "float" || s == "float32") return ScalarType::F32;
-    if (s == "double" || s == "float64") return ScalarType::F64;
-    return std::nullopt;
-}
-
-double readScalar(const char* p, ScalarType t, bool bigEndian) {
-    const int n = typeSize(t);
-    uint64_t bits = 0;
-    std::memcpy(&bits, p, size_t(n));
-    // Swap in a register (std::reverse on the byte array draws a GCC 12 false warning).
-    if (bigEndian) bits = __builtin_bswap64(bits) >> (64 - 8 * n);
-    unsigned char b[8];
-    std::memcpy(b, &bits, 8);
-    switch (t) {
-        case ScalarType::I8:
-            return double(int8_t(b[0]));
-        case ScalarType::U8:
-            return double(b[0]);
-        case ScalarType::I16: {
-            int16_t v;
-            std::memcpy(&v, b, 2);
-            return v;
-        }
-        case ScalarType::U16: {
-            uint16_t v;
-            std::memcpy(&v, b, 2);
-            return v;
-        }
-        case ScalarType::I32: {
-            int32_t v;
-            std::memcpy(&v, b, 4);
-            return v;
-        }
-        case ScalarType::U32: {
-            uint32_t v;
-            std::memcpy(&v, b, 4);
-            return v;
-        }
-        case ScalarType::F32: {
-            float v;
-            std::memcpy(&v, b, 4);
-            return v;
-        }
-        case ScalarType::F64: {
-            double v;
-            std::memcpy(&v, b, 8);
-            return v;
-        }
-    }
-    return 0;
-}
 
 // Which per-point attribute a property name feeds.
 Attr attrOf(const std::string& name) {
@@ -173,11 +67,11 @@ void PointSink::reserve(const std::string& file, size_t n, bool normals, bool co
     const uint64_t perPoint = 24 + 12 + (normals ? 24 : 0) + (colors ? 6 : 0) + (radius ? 8 : 0) + (intensity ? 8 : 0);
     checkMemory(file, uint64_t(n) * perPoint, "loading " + std::to_string(n) + " points",
                 "subsample the cloud, e.g. with pcl_voxel_grid");
-    resizeHuge(pos, n);
-    if (normals) resizeHuge(nrm, n);
-    if (colors) resizeHuge(col, n);
-    if (radius) resizeHuge(rad, n);
-    if (intensity) resizeHuge(inten, n);
+    resizeHugePages(pos, n);
+    if (normals) resizeHugePages(nrm, n);
+    if (colors) resizeHugePages(col, n);
+    if (radius) resizeHugePages(rad, n);
+    if (intensity) resizeHugePages(inten, n);
 }
 
 namespace {
@@ -214,8 +108,8 @@ void PointSink::finish(const std::string& file, PointCloud& out) {
     if (kept == 0)
         throw Error(file,
                     n == 0 ? "empty point cloud" : "no point with finite coordinates (all NaN, inf or beyond 1e18)");
-    resizeHuge(out.positions, kept);
-    if (!nrm.empty()) resizeHuge(out.normals, kept);
+    resizeHugePages(out.positions, kept);
+    if (!nrm.empty()) resizeHugePages(out.normals, kept);
     if (!col.empty()) out.colors.resize(kept);
     if (!rad.empty()) out.radii.resize(kept);
     if (!inten.empty()) out.intensities.resize(kept);
@@ -247,116 +141,13 @@ void PointSink::finish(const std::string& file, PointCloud& out) {
 }  // namespace detail
 
 using namespace detail;
+using io::decodeScalar;
+using io::PlyElement;
+using io::PlyHeader;
+using io::readPlyHeader;
+using io::scalarBytes;
 
 namespace {
-
-struct PlyProperty {
-    std::string name;
-    ScalarType type = ScalarType::F32;
-    bool isList = false;
-    ScalarType countType = ScalarType::U8;
-};
-struct PlyElement {
-    std::string name;
-    uint64_t count = 0;
-    std::vector<PlyProperty> props;
-};
-enum class PlyFormat { Ascii, BinaryLE, BinaryBE };
-struct PlyHeader {
-    PlyFormat format = PlyFormat::Ascii;
-    std::vector<PlyElement> elements;
-    size_t bodyOffset = 0;
-};
-
-PlyHeader parsePlyHeader(const MappedFile& f) {
-    const std::string& file = f.name;
-    if (f.size < 4 || std::memcmp(f.data, "ply", 3) != 0 || (f.data[3] != '\n' && f.data[3] != '\r'))
-        throw Error(file, "not a PLY file (missing 'ply' magic)");
-    // The header is searched within its first 1 MiB only: a file without end_header there
-    // is not read further (a hostile comment of megabytes would otherwise be parsed whole).
-    constexpr size_t kMaxHeader = size_t(1) << 20;
-    const size_t limit = std::min(f.size, kMaxHeader);
-    const std::string_view head(f.data, limit);
-    // end_header as a line of its own (not inside a comment).
-    size_t end = 0;
-    for (size_t from = 0;; from = end + 1) {
-        end = head.find("end_header", from);
-        if (end == std::string_view::npos) break;
-        const size_t after = end + 10;
-        const bool lineEnds = after >= head.size() || head[after] == '\n' || head[after] == '\r' || head[after] == ' ';
-        if (end > 0 && head[end - 1] == '\n' && lineEnds) break;
-    }
-    const size_t body = end == std::string_view::npos ? end : head.find('\n', end);
-    if (body == std::string_view::npos && f.size > kMaxHeader)
-        throw Error(file, "PLY header longer than the 1 MiB limit (no end_header line in the first 1048576 bytes)");
-    if (end == std::string_view::npos) throw Error(file, "PLY header has no end_header (truncated?)");
-    if (body == std::string_view::npos) throw Error(file, "PLY header not terminated by a newline");
-    PlyHeader h;
-    h.bodyOffset = body + 1;
-    std::istringstream in{std::string(head.substr(0, end))};
-    std::string line;
-    bool haveFormat = false;
-    std::getline(in, line);  // "ply"
-    while (std::getline(in, line)) {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        std::istringstream ls(line);
-        std::string kw;
-        ls >> kw;
-        if (kw.empty() || kw == "comment" || kw == "obj_info") continue;
-        if (kw == "format") {
-            std::string fmt, ver;
-            ls >> fmt >> ver;
-            if (fmt == "ascii")
-                h.format = PlyFormat::Ascii;
-            else if (fmt == "binary_little_endian")
-                h.format = PlyFormat::BinaryLE;
-            else if (fmt == "binary_big_endian")
-                h.format = PlyFormat::BinaryBE;
-            else
-                throw Error(file, "unknown PLY format '" + fmt + "'");
-            haveFormat = true;
-        } else if (kw == "element") {
-            PlyElement e;
-            std::string count;
-            ls >> e.name >> count;
-            if (count.empty() || count[0] == '-') throw Error(file, "bad count for element '" + e.name + "'");
-            auto [p, ec] = std::from_chars(count.data(), count.data() + count.size(), e.count);
-            if (ec != std::errc{} || p != count.data() + count.size())
-                throw Error(file, "bad count '" + count + "' for element '" + e.name + "'");
-            h.elements.push_back(e);
-        } else if (kw == "property") {
-            if (h.elements.empty()) throw Error(file, "PLY property before any element");
-            PlyProperty p;
-            std::string t;
-            ls >> t;
-            if (t == "list") {
-                std::string ct, it;
-                ls >> ct >> it >> p.name;
-                auto c = parseType(ct), i = parseType(it);
-                if (!c || !i) throw Error(file, "bad list property types in PLY header");
-                p.isList = true;
-                p.countType = *c;
-                p.type = *i;
-            } else {
-                auto ty = parseType(t);
-                if (!ty) throw Error(file, "unknown PLY property type '" + t + "'");
-                p.type = *ty;
-                ls >> p.name;
-            }
-            h.elements.back().props.push_back(p);
-        } else {
-            throw Error(file, "unexpected PLY header line '" + line + "'");
-        }
-    }
-    if (!haveFormat) throw Error(file, "PLY header has no format line");
-    return h;
-}
-
-const PlyElement* findElement(const PlyHeader& h, const std::string& name) {
-    for (const auto& e : h.elements)
-        if (e.name == name) return &e;
-    return nullptr;
-}
 
 // Ascii token reader over the mapped body.
 struct Tokens {
@@ -384,38 +175,28 @@ struct Tokens {
     }
 };
 
-// Bytes one binary element occupies when it has no list properties, else 0.
-size_t fixedSize(const PlyElement& e) {
-    size_t s = 0;
-    for (const auto& p : e.props) {
-        if (p.isList) return 0;
-        s += size_t(typeSize(p.type));
-    }
-    return s;
-}
-
 // Skips `e` in a binary body, walking lists; throws when the body ends early.
 size_t skipBinary(const MappedFile& f, size_t off, const PlyElement& e, bool be) {
-    const size_t fs = fixedSize(e);
+    const size_t fs = e.fixedBytes();
     if (fs > 0) {
-        if (e.count > (f.size - off) / fs)
-            throw Error(f.name, "PLY element '" + e.name + "' runs past the end of the file");
+        if (e.count > (f.size() - off) / fs)
+            throw Error(f.name(), "PLY element '" + e.name + "' runs past the end of the file");
         return off + fs * e.count;
     }
     for (uint64_t i = 0; i < e.count; ++i) {
         for (const auto& p : e.props) {
             if (!p.isList) {
-                off += size_t(typeSize(p.type));
-                if (off > f.size) throw Error(f.name, "PLY body truncated in element '" + e.name + "'");
+                off += size_t(scalarBytes(p.type));
+                if (off > f.size()) throw Error(f.name(), "PLY body truncated in element '" + e.name + "'");
                 continue;
             }
-            const size_t cs = size_t(typeSize(p.countType));
-            if (off + cs > f.size) throw Error(f.name, "PLY body truncated in element '" + e.name + "'");
-            const double c = readScalar(f.data + off, p.countType, be);
+            const size_t cs = size_t(scalarBytes(p.countType));
+            if (off + cs > f.size()) throw Error(f.name(), "PLY body truncated in element '" + e.name + "'");
+            const double c = decodeScalar(f.data() + off, p.countType, be);
             off += cs;
-            if (!(c >= 0) || c * typeSize(p.type) > double(f.size - off))
-                throw Error(f.name, "PLY list in element '" + e.name + "' runs past the end of the file");
-            off += size_t(c) * size_t(typeSize(p.type));
+            if (!(c >= 0) || c * scalarBytes(p.type) > double(f.size() - off))
+                throw Error(f.name(), "PLY list in element '" + e.name + "' runs past the end of the file");
+            off += size_t(c) * size_t(scalarBytes(p.type));
         }
     }
     return off;
@@ -425,14 +206,12 @@ size_t skipBinary(const MappedFile& f, size_t off, const PlyElement& e, bool be)
 
 std::optional<PointFileInfo> probePly(const std::string& file) {
     MappedFile f(file);
-    const PlyHeader h = parsePlyHeader(f);
-    const PlyElement* v = findElement(h, "vertex");
-    const PlyElement* faces = findElement(h, "face");
+    const PlyHeader h = readPlyHeader(f);
+    const PlyElement* v = h.find("vertex");
+    const PlyElement* faces = h.find("face");
     if (!v || (faces && faces->count > 0)) return std::nullopt;
     PointFileInfo info;
-    info.format = h.format == PlyFormat::Ascii      ? "ply ascii"
-                  : h.format == PlyFormat::BinaryLE ? "ply binary_little_endian"
-                                                    : "ply binary_big_endian";
+    info.format = h.formatName();
     info.points = v->count;
     for (const auto& p : v->props) info.properties.push_back(p.name);
     return info;
@@ -480,11 +259,11 @@ void detail::storeAttr(PointSink& sink, size_t i, Attr a, double x, ScalarType t
 
 PointCloud loadPly(const std::string& file) {
     MappedFile f(file);
-    const PlyHeader h = parsePlyHeader(f);
-    const PlyElement* v = findElement(h, "vertex");
+    const PlyHeader h = readPlyHeader(f);
+    const PlyElement* v = h.find("vertex");
     if (!v) throw Error(file, "PLY file has no vertex element");
     if (v->count == 0) throw Error(file, "empty point cloud (0 vertices)");
-    const bool be = h.format == PlyFormat::BinaryBE;
+    const bool be = h.bigEndian();
     // Property slots per attribute.
     struct Slot {
         Attr attr;
@@ -496,36 +275,33 @@ PointCloud loadPly(const std::string& file) {
     size_t off = 0;
     for (const auto& p : v->props) {
         if (p.isList) {
-            if (h.format != PlyFormat::Ascii)
-                throw Error(file, "list properties in the vertex element are not supported");
+            if (!h.ascii()) throw Error(file, "list properties in the vertex element are not supported");
         } else {
             const Attr a = attrOf(p.name);
             if (a != Attr::None && !has[int(a)]) {
                 slots.push_back({a, p.type, off});
                 has[int(a)] = true;
             }
-            off += size_t(typeSize(p.type));
+            off += size_t(scalarBytes(p.type));
         }
     }
     if (!has[int(Attr::X)] || !has[int(Attr::Y)] || !has[int(Attr::Z)])
         throw Error(file, "PLY vertices lack x, y or z");
     PointCloud cloud;
-    cloud.format = h.format == PlyFormat::Ascii ? "ply ascii"
-                   : be                         ? "ply binary_big_endian"
-                                                : "ply binary_little_endian";
+    cloud.format = h.formatName();
     for (const auto& p : v->props) cloud.properties.push_back(p.name);
     const bool hasN = has[int(Attr::NX)] && has[int(Attr::NY)] && has[int(Attr::NZ)];
     const bool hasC = has[int(Attr::R)] && has[int(Attr::G)] && has[int(Attr::B)];
     PointSink sink;
     const size_t n = size_t(v->count);
 
-    if (h.format == PlyFormat::Ascii) {
+    if (h.ascii()) {
         // Each value takes at least two bytes ("0 "): a cheap bound before allocating.
-        const size_t remaining = f.size - h.bodyOffset;
+        const size_t remaining = f.size() - h.headerBytes;
         if (v->count > remaining / std::max<size_t>(2 * v->props.size(), 2))
             throw Error(file,
                         "PLY header declares " + std::to_string(v->count) + " vertices but the file is too small");
-        Tokens tk{f.data + h.bodyOffset, f.data + f.size};
+        Tokens tk{f.data() + h.headerBytes, f.data() + f.size()};
         for (const auto& e : h.elements) {
             if (&e == v) break;
             if (e.count > remaining / 2) throw Error(file, "PLY element '" + e.name + "' count exceeds the file size");
@@ -563,20 +339,20 @@ PointCloud loadPly(const std::string& file) {
             }
         }
     } else {
-        size_t pos = h.bodyOffset;
+        size_t pos = h.headerBytes;
         for (const auto& e : h.elements) {
             if (&e == v) break;
             pos = skipBinary(f, pos, e, be);
         }
-        const size_t stride = fixedSize(*v);
+        const size_t stride = v->fixedBytes();
         if (stride == 0) throw Error(file, "PLY vertex element has no fixed-size layout");
-        if (v->count > (f.size - pos) / stride)
+        if (v->count > (f.size() - pos) / stride)
             throw Error(file, "PLY header declares " + std::to_string(v->count) + " vertices (" +
                                   std::to_string(v->count * stride) + " bytes) but only " +
-                                  std::to_string(f.size - pos) +
+                                  std::to_string(f.size() - pos) +
                                   " bytes follow the header (truncated or lying header)");
         sink.reserve(file, n, hasN, hasC, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
-        const char* base = f.data + pos;
+        const char* base = f.data() + pos;
         // Fast path: little-endian float x,y,z.
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -588,7 +364,7 @@ PointCloud loadPly(const std::string& file) {
                         std::memcpy(&fv, rec + s.offset, 4);
                         x = fv;
                     } else {
-                        x = readScalar(rec + s.offset, s.type, be);
+                        x = decodeScalar(rec + s.offset, s.type, be);
                     }
                     storeAttr(sink, i, s.attr, x, s.type, hasN, hasC);
                 }
@@ -636,16 +412,16 @@ void writePly(const std::string& file, const PointCloud& c) {
 
 TriangleMesh loadPlyMesh(const std::string& file) {
     MappedFile f(file);
-    const PlyHeader h = parsePlyHeader(f);
-    const PlyElement* v = findElement(h, "vertex");
-    const PlyElement* fe = findElement(h, "face");
+    const PlyHeader h = readPlyHeader(f);
+    const PlyElement* v = h.find("vertex");
+    const PlyElement* fe = h.find("face");
     if (!v || !fe || fe->count == 0) throw Error(file, "PLY file has no faces (not a mesh)");
     PointCloud pts = loadPly(file);  // validated vertex positions (no NaN dropping for meshes with NaNs)
     if (pts.droppedNonFinite) throw Error(file, "mesh has vertices with non-finite coordinates");
     TriangleMesh m;
     m.vertices = std::move(pts.positions);
-    const bool be = h.format == PlyFormat::BinaryBE;
-    const size_t remaining = f.size - h.bodyOffset;
+    const bool be = h.bigEndian();
+    const size_t remaining = f.size() - h.headerBytes;
     if (fe->count > remaining / 2) throw Error(file, "PLY face count exceeds the file size");
     int listIdx = -1;
     for (size_t i = 0; i < fe->props.size(); ++i)
@@ -660,8 +436,8 @@ TriangleMesh loadPlyMesh(const std::string& file) {
             m.triangles.push_back({uint32_t(idx[0]), uint32_t(idx[j - 1]), uint32_t(idx[j])});
     };
     std::vector<double> idx;
-    if (h.format == PlyFormat::Ascii) {
-        Tokens tk{f.data + h.bodyOffset, f.data + f.size};
+    if (h.ascii()) {
+        Tokens tk{f.data() + h.headerBytes, f.data() + f.size()};
         for (const auto& e : h.elements) {
             const bool isFace = &e == fe;
             for (uint64_t i = 0; i < e.count; ++i)
@@ -680,7 +456,7 @@ TriangleMesh loadPlyMesh(const std::string& file) {
             if (isFace) break;
         }
     } else {
-        size_t pos = h.bodyOffset;
+        size_t pos = h.headerBytes;
         for (const auto& e : h.elements) {
             if (&e == fe) break;
             pos = skipBinary(f, pos, e, be);
@@ -689,18 +465,18 @@ TriangleMesh loadPlyMesh(const std::string& file) {
             for (size_t pi = 0; pi < fe->props.size(); ++pi) {
                 const auto& p = fe->props[pi];
                 if (!p.isList) {
-                    pos += size_t(typeSize(p.type));
-                    if (pos > f.size) throw Error(file, "PLY face data truncated");
+                    pos += size_t(scalarBytes(p.type));
+                    if (pos > f.size()) throw Error(file, "PLY face data truncated");
                     continue;
                 }
-                const size_t cs = size_t(typeSize(p.countType));
-                if (pos + cs > f.size) throw Error(file, "PLY face data truncated");
-                const double c = readScalar(f.data + pos, p.countType, be);
+                const size_t cs = size_t(scalarBytes(p.countType));
+                if (pos + cs > f.size()) throw Error(file, "PLY face data truncated");
+                const double c = decodeScalar(f.data() + pos, p.countType, be);
                 pos += cs;
-                const size_t is = size_t(typeSize(p.type));
-                if (!(c >= 0) || c * double(is) > double(f.size - pos)) throw Error(file, "PLY face data truncated");
+                const size_t is = size_t(scalarBytes(p.type));
+                if (!(c >= 0) || c * double(is) > double(f.size() - pos)) throw Error(file, "PLY face data truncated");
                 idx.clear();
-                for (size_t j = 0; j < size_t(c); ++j) idx.push_back(readScalar(f.data + pos + j * is, p.type, be));
+                for (size_t j = 0; j < size_t(c); ++j) idx.push_back(decodeScalar(f.data() + pos + j * is, p.type, be));
                 pos += size_t(c) * is;
                 if (int(pi) == listIdx) addPoly(idx);
             }

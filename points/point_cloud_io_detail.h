@@ -5,26 +5,15 @@
 #include <string>
 #include <vector>
 
+#include "core/io/mapped_file.h"
+#include "core/io/scalar_type.h"
 #include "points/point_cloud.h"
 #include "points/point_cloud_io.h"
 
 namespace rtfact::points::detail {
 
-// Read-only memory map of a whole file.
-struct MappedFile {
-    explicit MappedFile(const std::string& file);
-    ~MappedFile();
-    MappedFile(const MappedFile&) = delete;
-    MappedFile& operator=(const MappedFile&) = delete;
-    std::string name;
-    const char* data = nullptr;
-    size_t size = 0;
-};
-
-enum class ScalarType { I8, U8, I16, U16, I32, U32, F32, F64 };
-int typeSize(ScalarType t);
-std::optional<ScalarType> parseType(const std::string& s);
-double readScalar(const char* p, ScalarType t, bool bigEndian);
+using io::MappedFile;
+using io::ScalarType;
 
 enum class Attr { None, X, Y, Z, NX, NY, NZ, R, G, B, Radius, Intensity, Count };
 Attr attrOf(const std::string& name);

@@ -5,8 +5,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 
+#include "core/io/file_helpers.h"
 #include "core/util/error.h"
 #include "points/point_cloud_io.h"
 #include "points/point_cloud_io_detail.h"
@@ -50,34 +50,34 @@ XyzLayout detect(const MappedFile& f) {
     std::vector<double> vals;
     size_t pos = 0;
     int lineNo = 0;
-    while (pos < f.size) {
+    while (pos < f.size()) {
         size_t eol = pos;
-        while (eol < f.size && f.data[eol] != '\n') ++eol;
+        while (eol < f.size() && f.data()[eol] != '\n') ++eol;
         const size_t start = pos;
-        pos = std::min(eol + 1, f.size);
-        if (eol - start > 4096) throw Error(f.name, "line too long for an XYZ/PTS file");
-        if (!parseLine(f.data + start, f.data + eol, vals))
-            throw Error(f.name, "line " + std::to_string(lineNo + 1) + " is not a list of numbers");
+        pos = std::min(eol + 1, f.size());
+        if (eol - start > 4096) throw Error(f.name(), "line too long for an XYZ/PTS file");
+        if (!parseLine(f.data() + start, f.data() + eol, vals))
+            throw Error(f.name(), "line " + std::to_string(lineNo + 1) + " is not a list of numbers");
         ++lineNo;
         if (vals.empty()) continue;
         if (lineNo == 1 && vals.size() == 1) {
             // Compare as double before converting: a count beyond 2^53 cannot be a real file.
             if (!(vals[0] >= 0) || vals[0] != std::floor(vals[0]) || vals[0] > 9.0e15)
-                throw Error(f.name, "bad PTS point count");
+                throw Error(f.name(), "bad PTS point count");
             L.pts = true;
             L.declared = uint64_t(vals[0]);
-            if (L.declared == 0) throw Error(f.name, "empty point cloud (count 0)");
-            if (L.declared > (f.size - pos) / 6)
-                throw Error(f.name,
+            if (L.declared == 0) throw Error(f.name(), "empty point cloud (count 0)");
+            if (L.declared > (f.size() - pos) / 6)
+                throw Error(f.name(),
                             "PTS header declares " + std::to_string(L.declared) + " points but the file is too small");
             continue;
         }
-        if (vals.size() < 3) throw Error(f.name, "line " + std::to_string(lineNo) + " has fewer than 3 values");
+        if (vals.size() < 3) throw Error(f.name(), "line " + std::to_string(lineNo) + " has fewer than 3 values");
         L.columns = vals.size();
         L.firstLine = start;
         return L;
     }
-    throw Error(f.name, "empty point cloud (no data lines)");
+    throw Error(f.name(), "empty point cloud (no data lines)");
 }
 
 }  // namespace
@@ -88,8 +88,8 @@ std::optional<PointFileInfo> probeXyz(const std::string& file) {
     PointFileInfo info;
     info.format = L.pts ? "pts text" : "xyz text";
     size_t lines = 0;
-    for (size_t i = L.firstLine; i < f.size; ++i) lines += f.data[i] == '\n';
-    info.points = L.pts ? L.declared : lines + (f.size > 0 && f.data[f.size - 1] != '\n');
+    for (size_t i = L.firstLine; i < f.size(); ++i) lines += f.data()[i] == '\n';
+    info.points = L.pts ? L.declared : lines + (f.size() > 0 && f.data()[f.size() - 1] != '\n');
     info.properties = {"x", "y", "z"};
     return info;
 }
@@ -100,7 +100,7 @@ PointCloud loadXyz(const std::string& file) {
     const size_t cols = L.columns;
     std::vector<double> vals;
     // Column meaning from the first line.
-    parseLine(f.data + L.firstLine, std::find(f.data + L.firstLine, f.data + f.size, '\n'), vals);
+    parseLine(f.data() + L.firstLine, std::find(f.data() + L.firstLine, f.data() + f.size(), '\n'), vals);
     bool normals = false, colors = false, intensity = false;
     size_t nOff = 0, cOff = 0, iOff = 0;
     if (cols == 4)
@@ -122,16 +122,16 @@ PointCloud loadXyz(const std::string& file) {
     if (colors) cloud.properties.insert(cloud.properties.end(), {"red", "green", "blue"});
     PointSink sink;
     // A point line needs at least 6 bytes ("0 0 0\n"): bound the allocation by the file.
-    const size_t bound = (f.size - L.firstLine) / 6 + 1;
+    const size_t bound = (f.size() - L.firstLine) / 6 + 1;
     sink.pos.reserve(L.pts ? std::min<size_t>(L.declared, bound) : std::min<size_t>(bound, 1 << 20));
     size_t pos = L.firstLine, lineNo = 0;
-    while (pos < f.size) {
+    while (pos < f.size()) {
         size_t eol = pos;
-        while (eol < f.size && f.data[eol] != '\n') ++eol;
+        while (eol < f.size() && f.data()[eol] != '\n') ++eol;
         const size_t start = pos;
-        pos = std::min(eol + 1, f.size);
+        pos = std::min(eol + 1, f.size());
         ++lineNo;
-        if (!parseLine(f.data + start, f.data + eol, vals))
+        if (!parseLine(f.data() + start, f.data() + eol, vals))
             throw Error(file, "data line " + std::to_string(lineNo) + " is not a list of numbers");
         if (vals.empty()) continue;
         if (vals.size() != cols)
@@ -151,13 +151,7 @@ PointCloud loadXyz(const std::string& file) {
     return cloud;
 }
 
-namespace {
-std::string lowerExt(const std::string& file) {
-    std::string e = std::filesystem::path(file).extension().string();
-    for (char& c : e) c = char(std::tolower(c));
-    return e;
-}
-}  // namespace
+using io::lowerExt;
 
 PointCloud loadPointCloud(const std::string& file) {
     const std::string e = lowerExt(file);

@@ -25,32 +25,23 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "core/io/file_helpers.h"
+#include "core/io/mapped_file.h"
+#include "core/io/ply_header.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
 #include "core/util/vtk_quiet.h"
-#include "surfaces/ply_header.h"
+#include "surfaces/ply_reader.h"
 #include "surfaces/vtk_legacy_check.h"
 
 namespace rtfact {
 namespace fs = std::filesystem;
 
-Mesh readPly(const std::string& file, const PlyHeader& h);  // ply_reader.cpp
-
 namespace {
 
-std::string lowerExt(const std::string& file) {
-    std::string e = fs::path(file).extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return e;
-}
-
-uint64_t fileSize(const std::string& file) {
-    std::error_code ec;
-    const uint64_t s = fs::file_size(file, ec);
-    if (ec) throw Error(file, "cannot read file (" + ec.message() + ")");
-    return s;
-}
+using io::fileSize;
+using io::lowerExt;
 
 std::string readPrefix(const std::string& file, size_t n) {
     std::ifstream in(file, std::ios::binary);
@@ -440,9 +431,9 @@ MeshFileKind meshFileKind(const std::string& file) {
         regular = false;
     }
     if (ext == ".ply") {
-        if (!regular || !isPlyFile(file)) return MeshFileKind::Ply;  // let the loader report it
+        if (!regular || !io::isPlyFile(file)) return MeshFileKind::Ply;  // let the loader report it
         try {
-            const PlyHeader h = readPlyHeader(file);
+            const io::PlyHeader h = io::readPlyHeader(io::MappedFile(file));
             return plyHasFaces(h) ? MeshFileKind::Ply : MeshFileKind::NotMesh;
         } catch (const Error&) {
             return MeshFileKind::Ply;  // broken files are reported by the loader
@@ -469,18 +460,19 @@ Mesh loadMesh(const std::string& file) {
     Mesh m;
     VtkErrors errs;
     if (ext == ".ply") {
-        const PlyHeader h = readPlyHeader(file);
+        const io::MappedFile f(file);
+        const io::PlyHeader h = io::readPlyHeader(f);
         if (!h.find("vertex") || !h.hasProperty("vertex", "x") || !h.hasProperty("vertex", "y") ||
             !h.hasProperty("vertex", "z"))
             throw Error(file, "PLY file has no vertex element with x, y, z");
         if (!plyHasFaces(h)) {
-            for (const PlyElement& e : h.elements)
+            for (const io::PlyElement& e : h.elements)
                 if (isPlyFaceElement(e.name) && e.count > 0 && !plyIndexList(e))
                     throw Error(file, "PLY element '" + e.name + "' has no vertex_indices list");
             throw Error(file, "PLY file has no faces or triangle strips (a point cloud, see `rtfact points`)");
         }
         checkMeshMemory(file, h.count("vertex"), plyTriangleEstimate(h), h.fileBytes - h.headerBytes);
-        m = readPly(file, h);
+        m = readPly(f, h);
     } else if (ext == ".stl") {
         checkStl(file);
         vtkNew<vtkSTLReader> r;

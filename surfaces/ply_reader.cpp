@@ -1,14 +1,13 @@
 // PLY data reader (ASCII, binary little/big endian). Ours rather than VTK's: vtkPLYReader
 // crashes on corrupted face lists (found by flipping bytes of a real file), and every
 // count and index here is checked against the bytes actually present.
+#include "surfaces/ply_reader.h"
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 
 #include "core/util/error.h"
-#include "surfaces/mesh.h"
-#include "surfaces/ply_header.h"
 
 namespace rtfact {
 
@@ -23,55 +22,33 @@ struct Where {
 
 class PlyData {
    public:
-    PlyData(const std::string& file, const PlyHeader& h) : file_(file), h_(h) {
-        std::ifstream in(file, std::ios::binary);
-        in.seekg(std::streamoff(h.headerBytes));
-        // The size was checked against the announced elements; the buffer is the file.
-        buf_.resize(size_t(h.fileBytes - h.headerBytes));
-        in.read(buf_.data(), std::streamsize(buf_.size()));
-        if (size_t(in.gcount()) != buf_.size()) throw Error(file, "cannot read PLY data");
-    }
-    double value(char kind, int bytes) {
-        if (h_.format == PlyHeader::Format::Ascii) return asciiValue();
-        if (pos_ + size_t(bytes) > buf_.size()) throw Error(file_, "truncated PLY data (premature end of file)");
-        unsigned char b[8];
-        std::memcpy(b, buf_.data() + pos_, size_t(bytes));
-        pos_ += size_t(bytes);
-        if (h_.format == PlyHeader::Format::BinaryBE)
-            for (int i = 0; i < bytes / 2; ++i) std::swap(b[i], b[bytes - 1 - i]);
-        if (kind == 'f') {
-            if (bytes == 4) {
-                float f;
-                std::memcpy(&f, b, 4);
-                return f;
-            }
-            double d;
-            std::memcpy(&d, b, 8);
-            return d;
-        }
-        uint64_t u = 0;
-        std::memcpy(&u, b, size_t(bytes));  // little endian host
-        if (kind == 'u') return double(u);
-        const int shift = 64 - 8 * bytes;
-        return double(int64_t(u << shift) >> shift);
+    PlyData(const io::MappedFile& f, const io::PlyHeader& h)
+        : file_(f.name()), h_(h), buf_(f.bytes().substr(size_t(h.headerBytes))) {}
+    double value(io::ScalarType t) {
+        if (h_.ascii()) return asciiValue();
+        const size_t bytes = size_t(io::scalarBytes(t));
+        if (pos_ + bytes > buf_.size()) throw Error(file_, "truncated PLY data (premature end of file)");
+        const double v = io::decodeScalar(buf_.data() + pos_, t, h_.bigEndian());
+        pos_ += bytes;
+        return v;
     }
 
     // A list's length, checked against the bytes left, so that a corrupt count can drive
     // neither a long loop nor an allocation.
-    uint64_t listLength(const PlyProperty& p, const Where& where) {
-        const double c = value(p.countKind, p.countBytes);
+    uint64_t listLength(const io::PlyProperty& p, const Where& where) {
+        const double c = value(p.countType);
         if (!(c >= 0) || c != std::floor(c)) throw Error(file_, where.str() + ": bad list length " + number(c));
         // Binary values take their size; ASCII ones a character and a separator (but the last).
-        const double fits = ascii() ? double(remaining() + 1) / 2 : double(remaining()) / p.typeBytes;
+        const double fits = ascii() ? double(remaining() + 1) / 2 : double(remaining()) / io::scalarBytes(p.type);
         if (c > fits)
             throw Error(file_, "truncated or corrupt PLY data: " + where.str() + " lists " + number(c) +
                                    " values but only " + std::to_string(remaining()) + " bytes are left");
         return uint64_t(c);
     }
-    void skipList(const PlyProperty& p, uint64_t n) {
-        for (uint64_t j = 0; j < n; ++j) value(p.typeKind, p.typeBytes);
+    void skipList(const io::PlyProperty& p, uint64_t n) {
+        for (uint64_t j = 0; j < n; ++j) value(p.type);
     }
-    bool ascii() const { return h_.format == PlyHeader::Format::Ascii; }
+    bool ascii() const { return h_.ascii(); }
     const std::string& file() const { return file_; }
     size_t remaining() const { return buf_.size() - pos_; }
     // Short text for any double (a corrupt value may be 1e300).
@@ -95,8 +72,8 @@ class PlyData {
         return v;
     }
     std::string file_;
-    const PlyHeader& h_;
-    std::vector<char> buf_;
+    const io::PlyHeader& h_;
+    std::string_view buf_;  // the body, in the mapped file
     size_t pos_ = 0;
 };
 
@@ -108,11 +85,11 @@ uint32_t vertexIndex(const std::string& file, double x, uint64_t nv, const Where
 }
 
 // A polygon of n vertices, fanned from its first; degenerate triangles are dropped.
-void readPolygon(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, const Where& where,
+void readPolygon(PlyData& data, const io::PlyProperty& p, uint64_t n, uint64_t nv, const Where& where,
                  std::vector<uint32_t>& out) {
     uint32_t first = 0, prev = 0;
     for (uint64_t j = 0; j < n; ++j) {
-        const uint32_t id = vertexIndex(data.file(), data.value(p.typeKind, p.typeBytes), nv, where);
+        const uint32_t id = vertexIndex(data.file(), data.value(p.type), nv, where);
         if (j == 0)
             first = id;
         else if (j >= 2 && first != prev && prev != id && first != id)
@@ -125,13 +102,14 @@ void readPolygon(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, c
 // a strip. Every second triangle of a strip is reversed (b, a, c) so all keep the
 // orientation of the first; degenerate ones (used to stitch strips) are dropped but still
 // count for the alternation.
-void readStrip(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, const Where& where,
+void readStrip(PlyData& data, const io::PlyProperty& p, uint64_t n, uint64_t nv, const Where& where,
                std::vector<uint32_t>& out) {
-    const double restartU = p.typeKind == 'u' && !data.ascii() ? std::ldexp(1.0, 8 * p.typeBytes) - 1 : -1;
+    const double restartU =
+        io::isUnsignedType(p.type) && !data.ascii() ? std::ldexp(1.0, 8 * io::scalarBytes(p.type)) - 1 : -1;
     uint64_t run = 0;  // indices in the current strip
     uint32_t a = 0, b = 0;
     for (uint64_t j = 0; j < n; ++j) {
-        const double x = data.value(p.typeKind, p.typeBytes);
+        const double x = data.value(p.type);
         if (x == -1 || x == restartU) {
             run = 0;
             continue;
@@ -154,13 +132,14 @@ void readStrip(PlyData& data, const PlyProperty& p, uint64_t n, uint64_t nv, con
 
 }  // namespace
 
-Mesh readPly(const std::string& file, const PlyHeader& h) {
-    PlyData data(file, h);
+Mesh readPly(const io::MappedFile& f, const io::PlyHeader& h) {
+    const std::string& file = f.name();
+    PlyData data(f, h);
     Mesh m;
     m.source = file;
     const uint64_t nv = h.count("vertex");
     if (nv > uint64_t(UINT32_MAX)) throw Error(file, "more than 2^32 vertices");
-    for (const PlyElement& e : h.elements) {
+    for (const io::PlyElement& e : h.elements) {
         if (e.name == "vertex") {
             int px = -1, py = -1, pz = -1, nx = -1, ny = -1, nz = -1, cr = -1, cg = -1, cb = -1, tu = -1, tv = -1;
             for (int i = 0; i < int(e.props.size()); ++i) {
@@ -196,16 +175,16 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
             if (hasN) m.normals.resize(size_t(e.count));
             if (hasC) m.colors.resize(size_t(e.count));
             if (hasT) m.uvs.resize(2 * size_t(e.count));
-            const float colorScale = hasC && e.props[size_t(cr)].typeKind != 'f' ? 1.0f / 255.0f : 1.0f;
+            const float colorScale = hasC && !io::isFloatType(e.props[size_t(cr)].type) ? 1.0f / 255.0f : 1.0f;
             std::vector<double> v(e.props.size());
             for (uint64_t k = 0; k < e.count; ++k) {
                 for (size_t i = 0; i < e.props.size(); ++i) {
-                    const PlyProperty& p = e.props[i];
+                    const io::PlyProperty& p = e.props[i];
                     if (p.isList) {
                         data.skipList(p, data.listLength(p, Where{e.name, k}));
                         continue;
                     }
-                    v[i] = data.value(p.typeKind, p.typeBytes);
+                    v[i] = data.value(p.type);
                 }
                 m.positions[k] = {float(v[size_t(px)]), float(v[size_t(py)]), float(v[size_t(pz)])};
                 if (hasN)
@@ -218,12 +197,12 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
                 }
             }
         } else if (isPlyFaceElement(e.name)) {
-            const PlyProperty* idx = plyIndexList(e);
+            const io::PlyProperty* idx = plyIndexList(e);
             const bool strips = e.name == "tristrips";
             for (uint64_t k = 0; k < e.count; ++k) {
-                for (const PlyProperty& p : e.props) {
+                for (const io::PlyProperty& p : e.props) {
                     if (!p.isList) {
-                        data.value(p.typeKind, p.typeBytes);
+                        data.value(p.type);
                         continue;
                     }
                     const Where where{e.name, k};
@@ -239,9 +218,9 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
         } else {
             // Other elements are skipped value by value (sizes may vary with lists).
             for (uint64_t k = 0; k < e.count; ++k)
-                for (const PlyProperty& p : e.props) {
+                for (const io::PlyProperty& p : e.props) {
                     if (!p.isList) {
-                        data.value(p.typeKind, p.typeBytes);
+                        data.value(p.type);
                         continue;
                     }
                     data.skipList(p, data.listLength(p, Where{e.name, k}));
@@ -249,6 +228,44 @@ Mesh readPly(const std::string& file, const PlyHeader& h) {
         }
     }
     return m;
+}
+
+bool isPlyFaceElement(const std::string& element) { return element == "face" || element == "tristrips"; }
+
+const io::PlyProperty* plyIndexList(const io::PlyElement& e) {
+    for (const io::PlyProperty& p : e.props)
+        if (p.isList && (p.name == "vertex_indices" || p.name == "vertex_index")) return &p;
+    return nullptr;
+}
+
+bool plyHasFaces(const io::PlyHeader& h) {
+    for (const io::PlyElement& e : h.elements)
+        if (isPlyFaceElement(e.name) && e.count > 0 && plyIndexList(e)) return true;
+    return false;
+}
+
+uint64_t plyTriangleEstimate(const io::PlyHeader& h) {
+    const bool ascii = h.ascii();
+    uint64_t faces = 0, otherBytes = 0;
+    int stripIndexBytes = 0;
+    for (const io::PlyElement& e : h.elements) {
+        const io::PlyProperty* idx = plyIndexList(e);
+        if (e.name == "face") faces += e.count;
+        // ASCII: most indices of n vertices have about as many digits as n - 1 (the
+        // vertices' own bytes count as 2 per value, so the rest is generous anyway).
+        if (e.name == "tristrips" && idx)
+            stripIndexBytes =
+                ascii ? 1 + std::max<int>(1, int(std::to_string(std::max<uint64_t>(h.count("vertex"), 1) - 1).size()))
+                      : io::scalarBytes(idx->type);
+        // The same minimum sizes as the header check: counts only for lists.
+        uint64_t per = 0;
+        for (const io::PlyProperty& p : e.props)
+            per += ascii ? 2 : uint64_t(io::scalarBytes(p.isList ? p.countType : p.type));
+        otherBytes += per * e.count;
+    }
+    const uint64_t data = h.fileBytes > h.headerBytes ? h.fileBytes - h.headerBytes : 0;
+    const uint64_t strips = stripIndexBytes && data > otherBytes ? (data - otherBytes) / uint64_t(stripIndexBytes) : 0;
+    return faces + strips;
 }
 
 }  // namespace rtfact

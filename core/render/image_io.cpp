@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <random>
 
+#include "core/io/file_helpers.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
@@ -20,11 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string lowerExt(const std::string& path) {
-    std::string e = fs::path(path).extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return e;
-}
+using io::lowerExt;
 
 // libpng and libjpeg print their own diagnostics on stderr before OIIO reports the
 // failure; while an input image is decoded stderr goes to /dev/null, so that the user

@@ -20,7 +20,7 @@
 #include "core/util/error.h"
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
-#include "surfaces/ply_header.h"
+#include "surfaces/ply_reader.h"
 #include "tests/common/image_compare.h"
 
 using namespace rtfact;
@@ -307,7 +307,7 @@ TEST(PlyStrips, TriangleEstimateBoundsStrips) {
     for (const char* format : kFormats) {
         const std::string path = gridStripFile(std::string("estimate_") + format + ".ply", format, w, h, false);
         SCOPED_TRACE(path);
-        const uint64_t estimate = plyTriangleEstimate(readPlyHeader(path));
+        const uint64_t estimate = plyTriangleEstimate(io::readPlyHeader(io::MappedFile(path)));
         EXPECT_GE(estimate, triangles);
         EXPECT_LE(estimate, std::string(format) == "ascii" ? 2 * entries : entries);
     }
@@ -323,12 +323,12 @@ TEST(PlyHeader, GiantCommentNamesTheLimit) {
             << "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
             << "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     }
-    expectError(path, "PLY header longer than " + std::to_string(kMaxPlyHeaderBytes) + " bytes (the limit)");
+    expectError(path, "PLY header longer than " + std::to_string(io::kMaxPlyHeaderBytes) + " bytes (the limit)");
     // Just below the limit: loads.
     const std::string ok = dir() + "/long_comment.ply";
     {
         std::ofstream out(ok, std::ios::binary);
-        out << "ply\nformat ascii 1.0\ncomment " << std::string(kMaxPlyHeaderBytes - 1024, 'x') << "\n"
+        out << "ply\nformat ascii 1.0\ncomment " << std::string(io::kMaxPlyHeaderBytes - 1024, 'x') << "\n"
             << "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
             << "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     }
