@@ -2,7 +2,8 @@
 // settings and the accumulation buffer; renderPass() adds one sample per pixel at full
 // or reduced resolution. A camera, settings or scale change restarts the accumulation
 // and cancels the pass in flight. Setters, cancel() and the accessors may be called
-// from any thread while another renders; passes themselves run one at a time.
+// from any thread while another renders; passes themselves run one at a time (the
+// callbacks run inside a pass and must not start another).
 #pragma once
 #include <atomic>
 #include <functional>

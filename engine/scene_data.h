@@ -23,7 +23,7 @@ struct PointData {
 };
 
 struct MeshData {
-    std::shared_ptr<Mesh> mesh;  // as loaded (a material override works on a copy)
+    std::shared_ptr<Mesh> mesh;  // as loaded; released after the build unless keepSource
     std::string buildKey;
     std::shared_ptr<void> scene;           // MeshScene<BVH<Triangle>> or MeshScene<KdTree<Triangle>>
     std::shared_ptr<const Mesh> rendered;  // the mesh the scene was built from
