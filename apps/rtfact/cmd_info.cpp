@@ -1,7 +1,8 @@
-// `rtfact info FILE`: what a file holds, asked of each domain in turn.
+// `rtfact info FILE`: what a file holds, as the engine describes it.
+#include <cstdio>
+
 #include "apps/rtfact/commands.h"
-#include "core/util/error.h"
-#include "core/util/input_file.h"
+#include "engine/scene.h"
 
 namespace rtfact::app {
 
@@ -10,12 +11,9 @@ void addInfoCommand(CLI::App& app, CommandList& list) {
     CLI::App* cmd = app.add_subcommand("info", "Print what a mesh, point cloud or volume file holds");
     cmd->add_option("FILE", *file, "Input file (or DICOM directory)")->required();
     list.push_back({cmd, [file] {
-                        // Before any domain opens it: a named pipe would block every reader.
-                        requireFileOrDirectory(*file);
-                        if (auto r = volumeInfo(*file)) return *r;
-                        if (auto r = meshInfo(*file)) return *r;
-                        if (auto r = pointsInfo(*file)) return *r;
-                        throw Error(*file, "unknown file type");
+                        for (const auto& [key, value] : engine::fileInfo(*file))
+                            std::printf("%s:%s%s\n", key.c_str(), value.empty() ? "" : " ", value.c_str());
+                        return 0;
                     }});
 }
 

@@ -1,6 +1,5 @@
 // `rtfact volume FILE`: direct volume rendering (DVR, shaded DVR, MIP, isosurface) of CT,
-// MRI and OpenVDB data; `rtfact gen volume ...` synthetic volumes; `rtfact info` for volumes.
-#include <chrono>
+// MRI and OpenVDB data through the engine; `rtfact gen volume ...` synthetic volumes.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -8,20 +7,13 @@
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/render_command.h"
 #include "core/util/error.h"
-#include "volume/default_transfer_function.h"
 #include "volume/transfer_function.h"
-#include "volume/value_histogram.h"
 #include "volume/volume_generators.h"
-#include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
-#include "volume/volume_scene.h"
 
 namespace rtfact::app {
 
 using namespace rtfact::volume;
-static_assert(Integrator<VolumeIntegrator, VolumeScene<uint8_t>>);
-static_assert(Integrator<VolumeIntegrator, VolumeScene<uint16_t>>);
-static_assert(Integrator<VolumeIntegrator, VolumeScene<float>>);
 
 namespace {
 
@@ -69,7 +61,7 @@ struct LoadArgs {
     }
 };
 
-void parseClip(const std::string& c, VolumeRenderSettings& s) {
+void parseClip(const std::string& c, engine::VolumeSettings& s) {
     // axis:lo:hi with axis x|y|z and lo, hi fractions of the axis in [0, 1]
     char axis = 0;
     float lo = 0, hi = 0;
@@ -88,13 +80,13 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
     struct Opts {
         CommonOptions common;
         LoadArgs load;
-        std::string file, tf, mode = "dvr";
-        std::optional<float> iso, window, level;
-        float step = 0.5f;
+        std::string file, tf;
+        engine::VolumeSettings settings;
         std::vector<std::string> clips;
         bool noSkip = false;
     };
     auto o = std::make_shared<Opts>();
+    engine::VolumeSettings& vs = o->settings;
     CLI::App* cmd = app.add_subcommand("volume", "Direct volume rendering of CT/MRI/OpenVDB volumes");
     o->common.addTo(*cmd, "volume.png");
     cmd->add_option("FILE", o->file, "Volume: .raw .mhd/.mha .nrrd/.nhdr .nii[.gz] .vti .vdb or a DICOM directory")
@@ -103,95 +95,43 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
     cmd->add_option("--tf", o->tf,
                     "Transfer function: preset (ct-bone ct-skin ct-muscle mr-default grayscale viridis inferno "
                     "cool-warm) or FILE.json");
-    cmd->add_option("--mode", o->mode, "dvr|shaded|mip|iso")
+    cmd->add_option("--mode", vs.mode, joined(engine::volumeModes()))
         ->capture_default_str()
-        ->check(CLI::IsMember({"dvr", "shaded", "mip", "iso"}));
-    cmd->add_option("--iso", o->iso, "Isovalue in data units (iso mode)")->check(finiteNumber());
-    cmd->add_option("--step", o->step, "Ray-marching step in voxels")
+        ->check(CLI::IsMember(engine::volumeModes()));
+    cmd->add_option("--iso", vs.iso, "Isovalue in data units (iso mode)")->check(finiteNumber());
+    cmd->add_option("--step", vs.step, "Ray-marching step in voxels")
         ->capture_default_str()
         ->check(finiteRange(0.01, 64.0));
-    cmd->add_option("--window", o->window, "Window width in data units (e.g. Hounsfield)")->check(positiveFinite());
-    cmd->add_option("--level", o->level, "Window centre in data units")->check(finiteNumber());
+    cmd->add_option("--window", vs.window, "Window width in data units (e.g. Hounsfield)")->check(positiveFinite());
+    cmd->add_option("--level", vs.level, "Window centre in data units")->check(finiteNumber());
     cmd->add_option("--clip", o->clips, "Clip axis:lo:hi (fractions, e.g. z:0:0.5); repeatable")
         ->check(parsedBy(
             [](const std::string& c) {
-                VolumeRenderSettings s;
+                engine::VolumeSettings s;
                 parseClip(c, s);
             },
             "AXIS:LO:HI"));
     cmd->add_flag("--no-skip", o->noSkip, "Disable empty-space skipping (for comparisons)");
     list.push_back({cmd, [o] {
-                        CommonOptions& c = o->common;
-                        c.finalize();
-                        checkImageWritable(c.out);
-                        VolumeRenderSettings rs;
-                        rs.mode = o->mode == "shaded" ? VolumeMode::Shaded
-                                  : o->mode == "mip"  ? VolumeMode::MIP
-                                  : o->mode == "iso"  ? VolumeMode::Iso
-                                                      : VolumeMode::DVR;
-                        rs.stepVoxels = o->step;
-                        rs.skipping = !o->noSkip;
-                        for (auto& cl : o->clips) parseClip(cl, rs);
-                        // --tf is read before the volume so that a bad file fails fast; without it
-                        // the default follows the data (chosen once the volume is loaded).
-                        std::optional<TransferFunction> given;
-                        if (!o->tf.empty()) given = resolveTransferFunction(o->tf);
-                        Stats stats;
-                        auto t0 = std::chrono::steady_clock::now();
-                        const VolumeLoadOptions lopt = o->load.options(!c.quiet);
-                        BrickedVolume vol;
-                        const bool sparse =
-                            o->load.dims.empty() && o->file.size() > 4 && o->file.substr(o->file.size() - 4) == ".vdb";
-                        if (sparse) {
-                            // bricked straight from the sparse tree
-                            vol = loadBrickedVolume(o->file, lopt);
-                            stats.add("load_ms", msSince(t0));
-                            t0 = std::chrono::steady_clock::now();
-                        } else {
-                            VolumeGrid grid = loadVolume(o->file, lopt);
-                            stats.add("load_ms", msSince(t0));
-                            t0 = std::chrono::steady_clock::now();
-                            try {
-                                vol = brickVolume(grid, true);
-                            } catch (const Error& e) {
-                                throw Error(o->file, e.what());
-                            }
-                        }
-                        const auto [lo, hi] = vol.valueRange();
-                        TransferFunction tf;
-                        std::pair<float, float> window;
-                        if (given) {
-                            tf = *given;
-                            window = resolveWindow(tf, lo, hi, o->window, o->level);
-                        } else {
-                            const DefaultTransferFunction d = chooseDefaultTransferFunction(
-                                vol.meta, histogramOf(vol), rs.mode, typicalDepthVoxels(vol.dims, vol.spacing));
-                            tf = d.tf;
-                            window = o->window || o->level ? resolveWindow(tf, lo, hi, o->window, o->level) : d.window;
-                            stats.add("tf_default", d.describe());
-                        }
-                        const TFTable table = buildTable(tf, window, o->step);
-                        rs.iso = o->iso ? *o->iso : (lo <= -500.0f ? 300.0f : lo + 0.4f * (hi - lo));
-                        stats.add("voxels", (unsigned long long)vol.voxelCount());
-                        stats.add("bricks_stored", (unsigned long long)vol.storedBricks());
-                        stats.add("memory_mb", double(vol.memoryBytes()) / 1048576.0);
-                        gVolumeCounters.reset();
-                        double renderMs = 0;
-                        withVolumeScene(vol, table, rs, [&](const auto& scene) {
-                            stats.add("build_ms", msSince(t0));
-                            const CameraFrame frame = c.frame(scene.bounds(), {0.45f, -1.0f, 0.35f}, {0, 0, 1});
-                            renderMs = renderToFile(scene, VolumeIntegrator{}, c, frame, stats).ms;
-                        });
-                        const uint64_t samples = gVolumeCounters.samples, skipped = gVolumeCounters.skipped;
-                        stats.add("samples", (unsigned long long)samples);
-                        stats.add("msamples_per_s", renderMs > 0 ? double(samples) / (renderMs * 1000.0) : 0.0);
-                        stats.add("skipped_fraction",
-                                  samples + skipped ? double(skipped) / double(samples + skipped) : 0.0);
-                        stats.add("tf", tf.name);
-                        stats.add("window_lo", double(window.first));
-                        stats.add("window_hi", double(window.second));
-                        if (c.stats) stats.print();
-                        return 0;
+                        return runRenderCommand(
+                            o->common,
+                            [&] {
+                                engine::Settings s;
+                                s.volume = o->settings;
+                                s.volume.skipping = !o->noSkip;
+                                for (const std::string& cl : o->clips) parseClip(cl, s.volume);
+                                // --tf is read before the volume so that a bad file fails fast; without
+                                // it the engine chooses the default from the data.
+                                if (!o->tf.empty()) s.volume.tf = resolveTransferFunction(o->tf);
+                                return s;
+                            },
+                            [&] {
+                                engine::OpenOptions oo;
+                                oo.kind = engine::SceneKind::Volume;
+                                oo.volume = o->load.options(!o->common.quiet);
+                                oo.progress = !o->common.quiet;
+                                return engine::open({o->file}, oo);
+                            });
                     }});
 }
 
@@ -238,35 +178,6 @@ void addGenVolumeCommand(CLI::App& gen, CommandList& list) {
                                         storageName(g.storage));
                         return 0;
                     }});
-}
-
-std::optional<int> volumeInfo(const std::string& file) {
-    if (!looksLikeVolume(file)) return std::nullopt;
-    VolumeLoadOptions lo;
-    lo.progress = false;
-    const VolumeGrid g = loadVolume(file, lo);
-    const VolumeSummary s = summarize(g, 8);
-    std::printf(
-        "file: %s\nkind: volume\ndims: %d x %d x %d\nvoxels: %zu\ntype: %s (stored as %s, value = stored * %g + %g)\n",
-        file.c_str(), g.dims[0], g.dims[1], g.dims[2], g.voxelCount(), g.sourceType.c_str(), storageName(g.storage),
-        double(g.scale), double(g.offset));
-    std::printf("spacing: %g %g %g\norigin: %g %g %g\n", double(g.spacing.x), double(g.spacing.y), double(g.spacing.z),
-                double(g.origin.x), double(g.origin.y), double(g.origin.z));
-    const AABB b = g.bounds();
-    std::printf("bounds: [%g %g %g] - [%g %g %g]\n", double(b.lo.x), double(b.lo.y), double(b.lo.z), double(b.hi.x),
-                double(b.hi.y), double(b.hi.z));
-    std::printf("range: %g .. %g (mean %g)\nmemory_mb: %.2f\nhistogram (8 bins over the range, %% of voxels):",
-                double(s.lo), double(s.hi), s.mean, double(g.memoryBytes()) / 1048576.0);
-    for (uint64_t h : s.histogram)
-        std::printf(" %.1f", 100.0 * double(h) / double(std::max<size_t>(g.voxelCount(), 1)));
-    std::printf("\n");
-    if (!g.meta.modality.empty())
-        std::printf("modality: %s (%s)\n", g.meta.modality.c_str(), g.meta.modalitySource.c_str());
-    // what `rtfact volume FILE` renders with when no --tf is given
-    const DefaultTransferFunction d =
-        chooseDefaultTransferFunction(g.meta, histogramOf(g), VolumeMode::DVR, typicalDepthVoxels(g.dims, g.spacing));
-    std::printf("tf_default: %s\n", d.describe().c_str());
-    return 0;
 }
 
 }  // namespace rtfact::app

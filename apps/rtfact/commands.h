@@ -3,7 +3,6 @@
 #pragma once
 #include <CLI/CLI.hpp>
 #include <functional>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,10 +24,11 @@ void addGenPointsCommand(CLI::App& gen, CommandList& list);
 void addGenVolumeCommand(CLI::App& gen, CommandList& list);
 void addInfoCommand(CLI::App& app, CommandList& list);
 
-// `rtfact info FILE` asks each domain in turn; a domain returns nullopt for files that
-// are not its own, else the exit code after printing.
-std::optional<int> volumeInfo(const std::string& file);
-std::optional<int> meshInfo(const std::string& file);
-std::optional<int> pointsInfo(const std::string& file);
+// "a|b|c" for option help texts.
+inline std::string joined(const std::vector<std::string>& names) {
+    std::string s;
+    for (const std::string& n : names) s += (s.empty() ? "" : "|") + n;
+    return s;
+}
 
 }  // namespace rtfact::app

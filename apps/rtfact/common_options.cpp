@@ -1,6 +1,5 @@
 #include "apps/rtfact/common_options.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -156,21 +155,6 @@ CameraFrame CommonOptions::frame(const AABB& bounds, Vec3f viewDir, Vec3f upDefa
         f.up = alongView(Vec3f(0, 1, 0)) ? Vec3f(0, 0, 1) : Vec3f(0, 1, 0);
     }
     return f;
-}
-
-void Stats::add(const std::string& key, double value) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.3f", value);
-    add(key, std::string(buf));
-}
-
-void Stats::print() const {
-    for (const auto& [k, v] : kv_) std::printf("%s=%s\n", k.c_str(), v.c_str());
-    std::fflush(stdout);
-}
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace rtfact::app

@@ -1,10 +1,9 @@
-// The options every rendering subcommand shares, their parsing and the --stats output.
+// The options every rendering subcommand shares and their parsing.
 #pragma once
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include "core/math/aabb.h"
 #include "core/render/pinhole_camera.h"
@@ -47,23 +46,5 @@ CLI::Validator finiteNumber();
 Vec3f parseVec3(const std::string& text, const std::string& option);
 // Parses "WxH".
 std::pair<int, int> parseSize(const std::string& text);
-
-// key=value lines printed at the end of a run with --stats.
-class Stats {
-   public:
-    void add(const std::string& key, const std::string& value) { kv_.emplace_back(key, value); }
-    void add(const std::string& key, double value);
-    void add(const std::string& key, long long value) { add(key, std::to_string(value)); }
-    void add(const std::string& key, int value) { add(key, std::to_string(value)); }
-    void add(const std::string& key, unsigned long long value) { add(key, std::to_string(value)); }
-    void add(const std::string& key, unsigned long value) { add(key, std::to_string(value)); }
-    void print() const;
-
-   private:
-    std::vector<std::pair<std::string, std::string>> kv_;
-};
-
-// Milliseconds since `t0`.
-double msSince(std::chrono::steady_clock::time_point t0);
 
 }  // namespace rtfact::app

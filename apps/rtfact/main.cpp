@@ -5,6 +5,7 @@
 
 #include "apps/rtfact/commands.h"
 #include "core/util/error.h"
+#include "engine/usage_error.h"
 
 int main(int argc, char** argv) {
     using namespace rtfact::app;
@@ -31,6 +32,9 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::fprintf(stderr, "rtfact: error: %s\n(see rtfact --help)\n", e.what());
+        return 2;
+    } catch (const rtfact::engine::UsageError& e) {
+        std::fprintf(stderr, "rtfact: error: %s\n(see rtfact --help)\n", e.message().c_str());
         return 2;
     } catch (const rtfact::Error& e) {
         std::fprintf(stderr, "rtfact: error: %s\n", e.message().c_str());

@@ -7,7 +7,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
+#include <string>
 
+#include "core/concepts/renderer.h"
 #include "core/render/ray_stats.h"
 #include "core/util/progress.h"
 
@@ -19,12 +22,19 @@ struct RenderOptions {
     int spp = 1;
     bool progress = true;
     std::string label = "render";
+    int firstSample = 0;  // samples firstSample .. firstSample + spp - 1 (progressive passes)
+    // Set from any thread: no tile starts once it is true (a render stops within one tile
+    // per thread); the stats then say cancelled.
+    const std::atomic<bool>* cancel = nullptr;
+    // Called after each tile with (tiles done, tiles in all samples), from worker threads.
+    std::function<void(uint64_t, uint64_t)> onTile;
 };
 
 struct RenderStats {
     double ms = 0;
     uint64_t rays = 0;
     int threads = 0;
+    bool cancelled = false;
 };
 
 inline int resolveThreads(int requested) { return requested > 0 ? requested : tbb::this_task_arena::max_concurrency(); }
@@ -37,21 +47,26 @@ RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam, F
     const int spp = std::max(opt.spp, 1);
     RenderStats st;
     st.threads = resolveThreads(opt.threads);
-    std::atomic<uint64_t> rays{0};
+    std::atomic<uint64_t> rays{0}, done{0};
+    const uint64_t total = uint64_t(tiles) * uint64_t(spp);
+    auto cancelled = [&] { return opt.cancel && opt.cancel->load(std::memory_order_relaxed); };
     Progress progress(opt.label, uint64_t(tiles) * uint64_t(spp), opt.progress);
     const auto t0 = std::chrono::steady_clock::now();
     tbb::task_arena arena(st.threads);
     arena.execute([&] {
-        for (int s = 0; s < spp; ++s) {
+        for (int s = opt.firstSample; s < opt.firstSample + spp && !cancelled(); ++s) {
             tbb::parallel_for(
                 tbb::blocked_range<int>(0, tiles, 1),
                 [&](const tbb::blocked_range<int>& range) {
                     const uint64_t before = tlsRaysTraced;
                     for (int t = range.begin(); t != range.end(); ++t) {
+                        if (cancelled()) break;
                         const int x0 = (t % tx) * ts, y0 = (t / tx) * ts;
                         const Region region{x0, y0, std::min(x0 + ts, w), std::min(y0 + ts, h)};
                         renderer.template render<N>(scene, cam, fb, region, s);
                         progress.add();
+                        const uint64_t d = ++done;
+                        if (opt.onTile) opt.onTile(d, total);
                     }
                     rays += tlsRaysTraced - before;
                 },
@@ -61,6 +76,7 @@ RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam, F
     progress.finish();
     st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     st.rays = rays.load();
+    st.cancelled = cancelled() && done.load() < total;
     return st;
 }
 

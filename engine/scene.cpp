@@ -1,0 +1,276 @@
+#include "engine/scene.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "core/util/input_file.h"
+#include "engine/scene_data.h"
+#include "engine/usage_error.h"
+#include "points/point_cloud_io.h"
+#include "surfaces/mesh_loader.h"
+#include "volume/default_transfer_function.h"
+#include "volume/value_histogram.h"
+
+namespace rtfact::engine {
+
+using detail::SceneData;
+
+namespace {
+
+std::string fmt(const char* f, auto... args) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf, f, args...);
+    return buf;
+}
+
+std::string boundsText(const AABB& b) {
+    return fmt("[%g %g %g] - [%g %g %g]", double(b.lo.x), double(b.lo.y), double(b.lo.z), double(b.hi.x),
+               double(b.hi.y), double(b.hi.z));
+}
+
+std::shared_ptr<SceneData> makeData(SceneKind kind, std::string source) {
+    auto d = std::make_shared<SceneData>();
+    d->kind = kind;
+    d->source = std::move(source);
+    return d;
+}
+
+// What `rtfact volume` renders with when no TF is given.
+volume::DefaultTransferFunction defaultTF(const volume::BrickedVolume& v) {
+    return volume::chooseDefaultTransferFunction(v.meta, volume::histogramOf(v), volume::VolumeMode::DVR,
+                                                 volume::typicalDepthVoxels(v.dims, v.spacing));
+}
+
+void finishPoints(SceneData& d) {
+    const points::PointCloud& c = d.points.cloud;
+    d.bounds = c.bounds();
+    d.view.focus = d.bounds;
+    d.info.add("kind", "points");
+    d.info.add("points", (unsigned long long)c.size());
+    d.info.add("bounds", boundsText(d.bounds));
+    d.info.add("normals", c.normals.empty() ? "none" : "yes");
+    d.info.add("colors", c.colors.empty() ? "none" : "yes");
+    d.info.add("radii", c.radii.empty() ? "none" : "yes");
+}
+
+void finishMesh(SceneData& d) {
+    const Mesh& m = *d.mesh.mesh;
+    // The triangles' box (what the BVH bounds): unreferenced vertices do not count.
+    AABB b;
+    for (uint32_t i : m.indices) b.extend(m.positions[i]);
+    d.bounds = b;
+    d.view.focus = b;
+    d.info.add("kind", "mesh");
+    d.info.add("vertices", (unsigned long long)m.positions.size());
+    d.info.add("triangles", (unsigned long long)m.triangles());
+    d.info.add("bounds", boundsText(b));
+    d.info.add("materials", (unsigned long long)m.materials.size());
+}
+
+void finishVolume(SceneData& d) {
+    const volume::BrickedVolume& v = d.volume.vol;
+    d.bounds = v.bounds();
+    d.view = {d.bounds, {0.45f, -1.0f, 0.35f}, {0, 0, 1}};
+    const auto [lo, hi] = v.valueRange();
+    d.info.add("kind", "volume");
+    d.info.add("dims", fmt("%d x %d x %d", v.dims[0], v.dims[1], v.dims[2]));
+    d.info.add("voxels", (unsigned long long)v.voxelCount());
+    d.info.add("spacing", fmt("%g %g %g", double(v.spacing.x), double(v.spacing.y), double(v.spacing.z)));
+    d.info.add("bounds", boundsText(d.bounds));
+    d.info.add("range", fmt("%g .. %g", double(lo), double(hi)));
+    d.info.add("memory_mb", double(v.memoryBytes()) / 1048576.0);
+    d.info.add("tf_default", defaultTF(v).describe());
+}
+
+}  // namespace
+
+const char* kindName(SceneKind k) {
+    switch (k) {
+        case SceneKind::Points:
+            return "points";
+        case SceneKind::Mesh:
+            return "mesh";
+        case SceneKind::Volume:
+            return "volume";
+        default:
+            return "spheres";
+    }
+}
+
+SceneKind Scene::kind() const { return data->kind; }
+AABB Scene::bounds() const { return data->bounds; }
+const Stats& Scene::info() const { return data->info; }
+const Stats& Scene::loadStats() const { return data->load; }
+const std::vector<std::string>& Scene::warnings() const { return data->warnings; }
+const std::string& Scene::source() const { return data->source; }
+
+DefaultView Scene::defaultView(const Settings& s) const {
+    DefaultView v = data->view;
+    if (data->kind == SceneKind::Volume) {
+        // the clipped box, as the volume scene bounds it (index space -> world)
+        const volume::BrickedVolume& vol = data->volume.vol;
+        Vec3f lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            const float n1 = float(vol.dims[a] - 1);
+            lo[a] = std::clamp(s.volume.clipLo[a], 0.0f, 1.0f) * n1;
+            hi[a] = std::clamp(s.volume.clipHi[a], 0.0f, 1.0f) * n1;
+        }
+        v.focus = AABB{vol.origin + lo * vol.spacing, vol.origin + hi * vol.spacing};
+    }
+    return v;
+}
+
+Scene open(const std::vector<std::string>& files, const OpenOptions& opt) {
+    if (files.empty()) throw UsageError("FILE", "no input file");
+    SceneKind kind;
+    if (opt.kind) {
+        kind = *opt.kind;
+    } else {
+        // Before anything opens them: a named pipe would block every reader.
+        for (const std::string& f : files) requireFileOrDirectory(f);
+        if (files.size() == 1 && volume::looksLikeVolume(files[0]))
+            kind = SceneKind::Volume;
+        else if (meshFileKind(files[0]) != MeshFileKind::NotMesh)
+            kind = SceneKind::Mesh;
+        else if (files.size() == 1 && points::probePointFile(files[0]))
+            kind = SceneKind::Points;
+        else
+            throw Error(files[0], "unknown file type");
+    }
+    if (kind != SceneKind::Mesh && files.size() != 1)
+        throw UsageError("FILE", std::string("a ") + kindName(kind) + " scene is opened from one file");
+    std::string source = files[0];
+    for (size_t i = 1; i < files.size(); ++i) source += " " + files[i];
+    auto d = makeData(kind, source);
+    d->keepSource = opt.keepSource;
+    d->progress = opt.progress;
+    const auto t0 = std::chrono::steady_clock::now();
+    switch (kind) {
+        case SceneKind::Points: {
+            d->points.cloud = points::loadPointCloud(files[0]);
+            const double ms = msSince(t0);
+            const size_t n = d->points.cloud.size();
+            d->load.add("load_ms", ms);
+            d->load.add("points", (unsigned long long)n);
+            d->load.add("load_points_per_s", ms > 0 ? double(n) / (ms * 1e-3) : 0.0);
+            d->load.add("dropped_nonfinite", (unsigned long long)d->points.cloud.droppedNonFinite);
+            // Points lost on load are worth one line (all lost is an error in the loader).
+            if (std::string w = points::droppedPointsMessage(files[0], d->points.cloud); !w.empty())
+                d->warnings.push_back(std::move(w));
+            finishPoints(*d);
+            break;
+        }
+        case SceneKind::Mesh:
+            d->mesh.mesh = std::make_shared<Mesh>(loadMeshes(files));
+            d->load.add("load_ms", msSince(t0));
+            finishMesh(*d);
+            break;
+        case SceneKind::Volume: {
+            volume::VolumeLoadOptions lo = opt.volume;
+            lo.progress = opt.progress;
+            d->volume.vol = volume::loadBrickedVolume(files[0], lo);
+            d->load.add("load_ms", msSince(t0));
+            finishVolume(*d);
+            break;
+        }
+        default:
+            throw UsageError("FILE", "the sphere demo is not opened from a file (engine::spheres)");
+    }
+    return Scene{d};
+}
+
+Scene pointsFromArrays(std::vector<Vec3f> positions, std::vector<Vec3f> colors, std::vector<Vec3f> normals,
+                       std::vector<float> radii) {
+    const size_t n = positions.size();
+    auto sized = [n](size_t m, const char* what) {
+        if (m != 0 && m != n)
+            throw UsageError(what, "has " + std::to_string(m) + " entries for " + std::to_string(n) + " points");
+    };
+    sized(colors.size(), "colors");
+    sized(normals.size(), "normals");
+    sized(radii.size(), "radii");
+    if (n == 0) throw UsageError("positions", "no points");
+    auto d = makeData(SceneKind::Points, "");
+    points::PointCloud& c = d->points.cloud;
+    for (const Vec3f& p : positions)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            throw UsageError("positions", "non-finite coordinate");
+    c.positions = std::move(positions);
+    c.normals = std::move(normals);
+    c.radii = std::move(radii);
+    c.colors.reserve(colors.size());
+    for (const Vec3f& col : colors) {
+        auto b = [](float v) { return uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); };
+        c.colors.push_back({b(col.x), b(col.y), b(col.z)});
+    }
+    c.format = "memory";
+    finishPoints(*d);
+    return Scene{d};
+}
+
+Scene meshFromArrays(std::vector<Vec3f> vertices, std::vector<uint32_t> triangles) {
+    if (triangles.size() % 3 != 0) throw UsageError("triangles", "index count is not a multiple of 3");
+    auto d = makeData(SceneKind::Mesh, "");
+    auto m = std::make_shared<Mesh>();
+    m->source = "mesh arrays";
+    m->positions = std::move(vertices);
+    m->indices = std::move(triangles);
+    m->validate();
+    m->computeNormals();
+    m->normalsComputed = true;
+    d->mesh.mesh = std::move(m);
+    finishMesh(*d);
+    return Scene{d};
+}
+
+Scene volumeFromArray(std::vector<float> values, std::array<int, 3> dims, Vec3f spacing) {
+    for (int a = 0; a < 3; ++a)
+        if (dims[a] < 1) throw UsageError("dims", "every dimension must be at least 1");
+    const uint64_t n = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
+    if (n != values.size())
+        throw UsageError("values",
+                         "has " + std::to_string(values.size()) + " entries for " + std::to_string(n) + " voxels");
+    if (!(spacing.x > 0 && spacing.y > 0 && spacing.z > 0)) throw UsageError("spacing", "must be positive");
+    volume::VolumeGrid g;
+    for (int a = 0; a < 3; ++a) g.dims[a] = dims[a];
+    g.spacing = spacing;
+    g.storage = volume::Storage::F32;
+    g.sourceType = "f32";
+    g.bytes.resize(values.size() * sizeof(float));
+    std::memcpy(g.bytes.data(), values.data(), g.bytes.size());
+    values = {};
+    auto d = makeData(SceneKind::Volume, "");
+    try {
+        d->volume.vol = volume::brickVolume(g, true);
+    } catch (const Error& e) {
+        throw Error("volume array", e.what());
+    }
+    finishVolume(*d);
+    return Scene{d};
+}
+
+Scene spheres(int count) {
+    if (count < 0) throw UsageError("--count", "must not be negative");
+    auto d = makeData(SceneKind::Spheres, "");
+    const auto t0 = std::chrono::steady_clock::now();
+    d->spheres.scene = std::make_shared<SphereScene>(SphereScene::demo(count));
+    d->load.add("load_ms", 0.0);
+    d->load.add("build_ms", msSince(t0));
+    const SphereScene& s = *d->spheres.scene;
+    d->load.add("primitives", (unsigned long long)s.spheres.size());
+    d->bounds = s.bounds();
+    // Fit the view to the small spheres, not the ground sphere.
+    AABB focus;
+    for (size_t i = 1; i < s.spheres.size(); ++i) focus.extend(s.spheres[i].bounds());
+    if (focus.isEmpty()) focus = AABB{{-1, 0, -1}, {1, 1, 1}};
+    d->view = {focus, {0.0f, 0.8f, 1.0f}, {0, 1, 0}};
+    d->info.add("kind", "spheres");
+    d->info.add("spheres", (unsigned long long)s.spheres.size());
+    d->info.add("bounds", boundsText(d->bounds));
+    return Scene{d};
+}
+
+}  // namespace rtfact::engine

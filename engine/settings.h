@@ -1,0 +1,80 @@
+// What a render of each kind of scene is asked for: one settings type per domain, with
+// the library's defaults. Integrator and mode names map to types through one table per
+// domain (pointIntegrators() ... in the render units); unknown names throw UsageError.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/math/vec3f.h"
+#include "points/point_prepare.h"
+#include "surfaces/mesh.h"
+#include "volume/transfer_function.h"
+
+namespace rtfact::engine {
+
+enum class SceneKind { Points, Mesh, Volume, Spheres };
+const char* kindName(SceneKind k);
+
+struct PointSettings {
+    std::string integrator = "eyelight";  // pointIntegrators()
+    points::ColorMode color = points::ColorMode::Rgb;
+    bool lod = true;               // off: full detail
+    float lodQuality = 2.0f;       // node answered by its representative when size < footprint x Q
+    std::string normals = "auto";  // auto|estimate|file
+    float radius = 0.0f;           // > 0: one radius for every point
+    float radiusFactor = 1.0f;     // times the spacing estimate or the file's radii
+    int leafSize = 8;
+    int aoSamples = 8;
+};
+
+// A light of the mesh scene; point lights are scaled so that the scene centre receives
+// an irradiance of 0.85 (white surfaces facing the light stay below clipping).
+struct LightSpec {
+    enum class Kind { Point, Directional } kind = Kind::Point;
+    Vec3f v;  // position or direction (towards which the light travels)
+};
+
+struct MeshSettings {
+    std::string integrator = "direct";     // meshIntegrators()
+    std::vector<LightSpec> lights;         // empty: a key light above and left of the camera
+    std::optional<MeshMaterial> material;  // replaces every material (see materialOverride)
+    std::string bvh = "sah";               // sah|kdtree
+    int aoSamples = 16;
+    int maxDepth = 6;
+    std::string secondary = "auto";  // traversal of AO / bounce rays: auto|wide|packet
+};
+
+struct VolumeSettings {
+    std::string mode = "dvr";                    // volumeModes()
+    std::optional<volume::TransferFunction> tf;  // none: chosen from the data
+    std::optional<float> window, level, iso;     // data units; none: from the TF / data
+    float step = 0.5f;                           // voxels
+    Vec3f clipLo{0, 0, 0}, clipHi{1, 1, 1};      // fractions of each axis
+    bool skipping = true;
+};
+
+struct SpheresSettings {
+    std::string integrator = "direct";  // spheresIntegrators()
+};
+
+// The settings of every domain; a session uses the one of its scene's kind.
+struct Settings {
+    PointSettings points;
+    MeshSettings mesh;
+    VolumeSettings volume;
+    SpheresSettings spheres;
+};
+
+// The closed name tables (what the CLI offers).
+const std::vector<std::string>& pointIntegrators();
+const std::vector<std::string>& meshIntegrators();
+const std::vector<std::string>& volumeModes();
+const std::vector<std::string>& spheresIntegrators();
+
+// lambert[:kd] | mirror[:ks] | glass[:ior]: the replacement material of --material.
+MeshMaterial lambertMaterial(std::optional<Vec3f> kd = std::nullopt);
+MeshMaterial mirrorMaterial(std::optional<Vec3f> ks = std::nullopt);
+MeshMaterial glassMaterial(float ior = 1.5f);
+
+}  // namespace rtfact::engine
