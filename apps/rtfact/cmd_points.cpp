@@ -113,15 +113,16 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
              stats.add("tree_nodes", (unsigned long long)scene.tree.nodes.size());
              const PinholeCamera cam(frame, c.width, c.height);
              scene.setLoD(cam.cone(), o->lod == "off" ? 0.0f : o->lodQuality);
+             RenderStats rendered;
              if (o->integrator == "eyelight") {
-                 renderToFile(scene, EyeLightIntegrator{}, c, frame, stats);
+                 rendered = renderToFile(scene, EyeLightIntegrator{}, c, frame, stats);
              } else if (o->integrator == "ao") {
                  AOIntegrator ao;
                  ao.samples = o->aoSamples;
                  // Splats overlap their neighbours: start AO rays clear of the local surface.
                  ao.offset = 4e-3f;
                  ao.minDistance = 4e-3f;
-                 renderToFile(scene, ao, c, frame, stats);
+                 rendered = renderToFile(scene, ao, c, frame, stats);
              } else {
                  DirectLightIntegrator integ;
                  const AABB b = scene.bounds();
@@ -130,9 +131,9 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
                  integ.lights.push_back(PointLight{frame.eye + Vec3f(0, 1, 0) * length(e) + toEye * 0.2f * length(e),
                                                    Vec3f(2.5f * dot(e, e))});
                  integ.lights.push_back(DirectionalLight{{0.3f, -1.0f, -0.4f}, Vec3f(0.5f)});
-                 renderToFile(scene, integ, c, frame, stats);
+                 rendered = renderToFile(scene, integ, c, frame, stats);
              }
-             stats.add("lod_nodes_hit", (unsigned long long)scene.lodHits->load());
+             stats.add("lod_nodes_hit", (unsigned long long)rendered.counters.lodNodesHit);
              stats.add("lod_quality", o->lod == "off" ? 0.0 : double(o->lodQuality));
              if (c.stats) stats.print();
              return 0;

@@ -19,9 +19,6 @@
 namespace rtfact::app {
 
 using namespace rtfact::volume;
-static_assert(Integrator<VolumeIntegrator, VolumeScene<uint8_t>>);
-static_assert(Integrator<VolumeIntegrator, VolumeScene<uint16_t>>);
-static_assert(Integrator<VolumeIntegrator, VolumeScene<float>>);
 
 namespace {
 
@@ -175,14 +172,15 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
                         stats.add("voxels", (unsigned long long)vol.voxelCount());
                         stats.add("bricks_stored", (unsigned long long)vol.storedBricks());
                         stats.add("memory_mb", double(vol.memoryBytes()) / 1048576.0);
-                        gVolumeCounters.reset();
-                        double renderMs = 0;
+                        RenderStats rendered;
                         withVolumeScene(vol, table, rs, [&](const auto& scene) {
                             stats.add("build_ms", msSince(t0));
                             const CameraFrame frame = c.frame(scene.bounds(), {0.45f, -1.0f, 0.35f}, {0, 0, 1});
-                            renderMs = renderToFile(scene, VolumeIntegrator{}, c, frame, stats).ms;
+                            rendered = renderToFile(scene, VolumeIntegrator{}, c, frame, stats);
                         });
-                        const uint64_t samples = gVolumeCounters.samples, skipped = gVolumeCounters.skipped;
+                        const double renderMs = rendered.ms;
+                        const uint64_t samples = rendered.counters.volumeSamples;
+                        const uint64_t skipped = rendered.counters.volumeSkipped;
                         stats.add("samples", (unsigned long long)samples);
                         stats.add("msamples_per_s", renderMs > 0 ? double(samples) / (renderMs * 1000.0) : 0.0);
                         stats.add("skipped_fraction",
