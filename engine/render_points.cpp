@@ -37,8 +37,8 @@ std::unique_ptr<Renderable> make(std::shared_ptr<PointScene> scene, I integ, con
     auto r = std::make_unique<RenderableOf<PointScene, I>>(scene, std::move(integ));
     const float quality = s.lod ? s.lodQuality : 0.0f;
     r->onCamera = [quality](PointScene& sc, const PinholeCamera& cam) { sc.setLoD(cam.cone(), quality); };
-    r->stats = [scene, quality](Stats& st, const RenderStats&) {
-        st.add("lod_nodes_hit", (unsigned long long)scene->lodHits->load());
+    r->stats = [quality](Stats& st, const RenderStats& rst) {
+        st.add("lod_nodes_hit", (unsigned long long)rst.counters.lodNodesHit);
         st.add("lod_quality", double(quality));
     };
     return r;
@@ -96,7 +96,6 @@ std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSetting
         pd.buildKey = buildKey;
     }
     auto scene = std::static_pointer_cast<PointScene>(pd.scene);
-    scene->lodHits->store(0);
     if (s.integrator == "eyelight") return make(scene, EyeLightIntegrator{}, s);
     if (s.integrator == "ao") {
         AOIntegrator ao;
