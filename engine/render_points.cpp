@@ -5,13 +5,15 @@
 #include "core/render/ao_integrator.h"
 #include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
+#include "core/render/path_integrator.h"
+#include "core/render/whitted_integrator.h"
 #include "engine/renderable.h"
 #include "points/point_scene.h"
 
 namespace rtfact::engine {
 
 const std::vector<std::string>& pointIntegrators() {
-    static const std::vector<std::string> names{"eyelight", "direct", "ao"};
+    static const std::vector<std::string> names{"eyelight", "direct", "ao", "whitted", "path"};
     return names;
 }
 
@@ -104,6 +106,26 @@ std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSetting
         ao.offset = 4e-3f;
         ao.minDistance = 4e-3f;
         return make(scene, ao, s);
+    }
+    // Whitted and path tracing: the core's integrators on the disc scene (front/back from
+    // the disc normal), a white Lambert material so the points' colours show.
+    PathMaterial white;
+    white.albedo = Vec3f(1.0f);
+    if (s.integrator == "path") {
+        PathIntegrator pt;
+        pt.maxDepth = 6;
+        pt.materials = {white};
+        pt.background = Vec3f(0.9f, 0.95f, 1.0f);  // lit by a bright sky, as meshes without emitters
+        return make(scene, pt, s);
+    }
+    if (s.integrator == "whitted") {
+        WhittedIntegrator w;
+        w.lights = pointLightRig(scene->bounds(), frame);
+        w.maxDepth = 8;
+        w.materials = {white};
+        auto r = make(scene, w, s);
+        r->followsCamera = true;
+        return r;
     }
     DirectLightIntegrator integ;
     integ.lights = pointLightRig(scene->bounds(), frame);
