@@ -5,6 +5,7 @@
 // white furnace neither create nor (much) lose energy, packet sizes agree.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/image_compare.h"
@@ -120,7 +121,11 @@ TEST(PointShading, WhittedLambertCloudEqualsDirectLight) {
     int lit = 0;
     for (size_t i = 0; i < a.depth.size(); ++i) {
         if (!(a.depth[i] < kInfinity)) continue;
-        for (int c = 0; c < 3; ++c) EXPECT_EQ(a.rgba[4 * i + c], b.rgba[4 * i + c]) << "pixel " << i;
+        // The same sum through shadeDirect; the two integrators are separate functions the
+        // compiler may contract into FMAs differently, so equal up to float rounding.
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(a.rgba[4 * i + c], b.rgba[4 * i + c], 1e-6f * std::max(1.0f, a.rgba[4 * i + c]))
+                << "pixel " << i;
         lit += a.rgba[4 * i] > 0.2f;
     }
     EXPECT_GT(lit, a.hits() / 4);  // not just the ambient term
