@@ -195,11 +195,10 @@ int benchVolume(int argc, char** argv) {
                 RenderOptions ro;
                 ro.threads = th;
                 ro.progress = false;
-                gVolumeCounters.reset();
                 RenderStats st;
                 if (!dispatchPacketSize(packet, [&]<int N>() { st = renderImage<N>(renderer, scene, cam, fb, ro); }))
                     throw Error("--packet", "unsupported packet size");
-                if (st.ms < best.ms) best = {st.ms, gVolumeCounters.samples.load()};
+                if (st.ms < best.ms) best = {st.ms, st.counters.volumeSamples};
                 if (f == 0) ourImage = fb.resolved(1);
             }
         });

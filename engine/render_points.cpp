@@ -5,13 +5,15 @@
 #include "core/render/ao_integrator.h"
 #include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
+#include "core/render/path_integrator.h"
+#include "core/render/whitted_integrator.h"
 #include "engine/renderable.h"
 #include "points/point_scene.h"
 
 namespace rtfact::engine {
 
 const std::vector<std::string>& pointIntegrators() {
-    static const std::vector<std::string> names{"eyelight", "direct", "ao"};
+    static const std::vector<std::string> names{"eyelight", "direct", "ao", "whitted", "path"};
     return names;
 }
 
@@ -37,8 +39,8 @@ std::unique_ptr<Renderable> make(std::shared_ptr<PointScene> scene, I integ, con
     auto r = std::make_unique<RenderableOf<PointScene, I>>(scene, std::move(integ));
     const float quality = s.lod ? s.lodQuality : 0.0f;
     r->onCamera = [quality](PointScene& sc, const PinholeCamera& cam) { sc.setLoD(cam.cone(), quality); };
-    r->stats = [scene, quality](Stats& st, const RenderStats&) {
-        st.add("lod_nodes_hit", (unsigned long long)scene->lodHits->load());
+    r->stats = [quality](Stats& st, const RenderStats& rst) {
+        st.add("lod_nodes_hit", (unsigned long long)rst.counters.lodNodesHit);
         st.add("lod_quality", double(quality));
     };
     return r;
@@ -96,7 +98,6 @@ std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSetting
         pd.buildKey = buildKey;
     }
     auto scene = std::static_pointer_cast<PointScene>(pd.scene);
-    scene->lodHits->store(0);
     if (s.integrator == "eyelight") return make(scene, EyeLightIntegrator{}, s);
     if (s.integrator == "ao") {
         AOIntegrator ao;
@@ -105,6 +106,26 @@ std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSetting
         ao.offset = 4e-3f;
         ao.minDistance = 4e-3f;
         return make(scene, ao, s);
+    }
+    // Whitted and path tracing: the core's integrators on the disc scene (front/back from
+    // the disc normal), a white Lambert material so the points' colours show.
+    PathMaterial white;
+    white.albedo = Vec3f(1.0f);
+    if (s.integrator == "path") {
+        PathIntegrator pt;
+        pt.maxDepth = 6;
+        pt.materials = {white};
+        pt.background = Vec3f(0.9f, 0.95f, 1.0f);  // lit by a bright sky, as meshes without emitters
+        return make(scene, pt, s);
+    }
+    if (s.integrator == "whitted") {
+        WhittedIntegrator w;
+        w.lights = pointLightRig(scene->bounds(), frame);
+        w.maxDepth = 8;
+        w.materials = {white};
+        auto r = make(scene, w, s);
+        r->followsCamera = true;
+        return r;
     }
     DirectLightIntegrator integ;
     integ.lights = pointLightRig(scene->bounds(), frame);

@@ -38,7 +38,7 @@ std::unique_ptr<Renderable> make(const BrickedVolume& v, const TFTable& table, c
     auto scene = std::make_shared<VolumeScene<T>>(v, table, rs);
     auto r = std::make_unique<RenderableOf<VolumeScene<T>, VolumeIntegrator>>(scene, VolumeIntegrator{});
     r->stats = [name = tf.name, window](Stats& st, const RenderStats& rst) {
-        const uint64_t samples = gVolumeCounters.samples, skipped = gVolumeCounters.skipped;
+        const uint64_t samples = rst.counters.volumeSamples, skipped = rst.counters.volumeSkipped;
         st.add("samples", (unsigned long long)samples);
         st.add("msamples_per_s", rst.ms > 0 ? double(samples) / (rst.ms * 1000.0) : 0.0);
         st.add("skipped_fraction", samples + skipped ? double(skipped) / double(samples + skipped) : 0.0);
@@ -79,7 +79,6 @@ std::unique_ptr<Renderable> makeVolumeRenderable(SceneData& d, const VolumeSetti
     stats.add("voxels", (unsigned long long)vol.voxelCount());
     stats.add("bricks_stored", (unsigned long long)vol.storedBricks());
     stats.add("memory_mb", double(vol.memoryBytes()) / 1048576.0);
-    gVolumeCounters.reset();
     std::unique_ptr<Renderable> r;
     switch (vol.storage) {
         case Storage::U8:

@@ -10,6 +10,8 @@
 
 #include "core/accel/kdtree_intersector.h"
 #include "core/concepts/camera.h"
+#include "core/concepts/intersector_hooks.h"
+#include "points/disc_intersector.h"
 #include "points/lod_kdtree.h"
 
 namespace rtfact::points {
@@ -57,6 +59,13 @@ struct LoDNodeIntersector {
         hi = intersection(cell, in.box(1));
     }
 };
+
+// Both hooks must reach the traversal: without them LoD cuts and clipped cells would
+// silently turn off.
+static_assert(KdTreeInnerNodeHook<LoDNodeIntersector<DiscIntersector>, KdTree<Disc>, 1> &&
+              KdTreeInnerNodeHook<LoDNodeIntersector<DiscIntersector>, KdTree<Disc>, simd::kNativeWidth> &&
+              KdTreeInnerNodeHook<LoDNodeIntersector<DiscIntersector>, KdTree<Disc>, 64>);
+static_assert(KdTreeChildCellsHook<LoDNodeIntersector<DiscIntersector>, KdTree<Disc>>);
 
 template <class ElemIsect>
 using LoDKdTreeIntersector = KdTreeIntersector<LoDNodeIntersector<ElemIsect>>;

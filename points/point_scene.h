@@ -1,11 +1,8 @@
 // PointScene: a point cloud as a GeometryScene (core/concepts/scene.h), so that the
-// core's generic integrators (eyelight, direct light with shadows) and the AO
-// integrator render it. Hits come from the LoD kd-tree; shading data from the disc or
+// core's generic integrators (eyelight, direct light with shadows, AO, Whitted and
+// path tracing) render it. Hits come from the LoD kd-tree; shading data from the disc or
 // representative disc hit, coloured by the chosen colour mode.
 #pragma once
-#include <atomic>
-#include <memory>
-
 #include "core/concepts/scene.h"
 #include "core/render/tracer.h"
 #include "points/disc_intersector.h"
@@ -26,7 +23,6 @@ struct PointScene {
     LoDKdTree tree;
     Tracer<LoDKdTreeIntersector<DiscIntersector>> tracer;
     ColorMode colorMode = ColorMode::Rgb;
-    std::shared_ptr<std::atomic<uint64_t>> lodHits = std::make_shared<std::atomic<uint64_t>>(0);
     template <int N>
     using Hit = DiscIntersector::Hit<N>;
 
@@ -76,11 +72,15 @@ struct PointScene {
                     c = unpackRGB(d.rgba);
                     break;
             }
-            if (dot(nn, rays.dir.lane(i)) > 0) nn = -nn;
+            // The stored normal points outwards: a ray along it leaves the surface.
+            if (dot(nn, rays.dir.lane(i)) > 0) {
+                nn = -nn;
+                sp.front.set(i, false);
+            }
             n.setLane(i, nn);
             col.setLane(i, c);
         }
-        if (reps) *lodHits += reps;
+        tlsCounters.lodNodesHit += reps;
         sp.n = n;
         sp.ng = n;
         sp.u = Packet<N>(0.0f);

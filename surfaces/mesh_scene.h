@@ -1,6 +1,6 @@
 // MeshScene<Structure>: a triangle mesh as a GeometryScene, on the core's BVH or kd-tree
 // with the generic packet intersectors around TriangleIntersector. Every core integrator
-// (eyelight, direct light) and the surface integrators of this library render it.
+// (eyelight, direct light, AO, Whitted, path) renders it.
 #pragma once
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -175,7 +175,8 @@ struct MeshScene {
     }
 
     // Position, interpolated shading normal, geometric normal (both facing the ray),
-    // uv, colour (vertex colour times material diffuse colour) and material id.
+    // uv, colour (vertex colour times material diffuse colour), material id and the
+    // side the ray arrives from (triangle winding).
     template <int N>
     SurfacePoint<N> surface(const RayPacket<N>& rays, const Hit<N>& hit, const Mask<N>& valid) const {
         SurfacePoint<N> sp;
@@ -193,7 +194,10 @@ struct MeshScene {
             const uint32_t i0 = m.indices[3 * t], i1 = m.indices[3 * t + 1], i2 = m.indices[3 * t + 2];
             const float bu = hit.u[i], bv = hit.v[i], bw = 1.0f - bu - bv;
             const Vec3f d = rays.dir.lane(i);
-            Vec3f ng = normalize(cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]));
+            const Vec3f wound = cross(m.positions[i1] - m.positions[i0], m.positions[i2] - m.positions[i0]);
+            // Closed meshes wind outwards: a ray along the wound normal leaves the object.
+            sp.front.set(i, !(dot(wound, d) > 0.0f));
+            Vec3f ng = normalize(wound);
             if (dot(ng, d) > 0.0f) ng = -ng;
             Vec3f n = normalize(m.normals[i0] * bw + m.normals[i1] * bu + m.normals[i2] * bv);
             if (dot(n, ng) < 0.0f) n = -n;
@@ -224,6 +228,9 @@ struct MeshScene {
 static_assert(GeometryScene<MeshScene<BVH<Triangle>>>);
 static_assert(GeometryScene<MeshScene<KdTree<Triangle>>>);
 // WideSecondaryRays reach the wide BVH only through these queries.
-static_assert(IncoherentQueries<MeshScene<BVH<Triangle>>, 1> && IncoherentQueries<MeshScene<BVH<Triangle>>, 64>);
+static_assert(IncoherentQueries<MeshScene<BVH<Triangle>>, 1> &&
+              IncoherentQueries<MeshScene<BVH<Triangle>>, simd::kNativeWidth> &&
+              IncoherentQueries<MeshScene<BVH<Triangle>>, 64>);
+static_assert(Intersector<WideBVHIntersector<TriangleIntersector>, WideBVH<Triangle, kMeshWideArity>>);
 
 }  // namespace rtfact

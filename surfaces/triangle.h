@@ -13,6 +13,7 @@
 #include <algorithm>
 
 #include "core/concepts/intersector.h"
+#include "core/concepts/intersector_hooks.h"
 #include "core/simd/bitmask.h"
 
 namespace rtfact {
@@ -138,5 +139,7 @@ struct TriangleIntersector {
     }
 };
 static_assert(ElementIntersector<TriangleIntersector, Triangle>);
+// The wide BVH tests whole leaves through this hook (else one triangle at a time).
+static_assert(LeafIntersector<TriangleIntersector, Triangle>);
 
 }  // namespace rtfact

@@ -6,9 +6,8 @@
 // and lanes drop out when they leave the box or become opaque.
 #pragma once
 #include "core/concepts/integrator.h"
-#include "core/render/ray_stats.h"
+#include "core/render/render_counters.h"
 #include "volume/volume_scene.h"
-#include "volume/volume_stats.h"
 #include "volume/voxel_gather.h"
 
 namespace rtfact::volume {
@@ -18,7 +17,7 @@ struct VolumeIntegrator {
 
     template <int N, class Scene>
     Radiance<N> eval(const Scene& s, RayPacket<N>& rays, const Mask<N>& active, const PixelSample<N>&) const {
-        tlsRaysTraced += uint64_t(popcount(active));
+        tlsCounters.rays += uint64_t(popcount(active));
         Radiance<N> r;
         uint64_t samples = 0;
         float skipped = 0;
@@ -32,8 +31,8 @@ struct VolumeIntegrator {
             r.alpha.chunk(k) = alpha;
             r.depth.chunk(k) = depth;
         }
-        gVolumeCounters.samples.fetch_add(samples, std::memory_order_relaxed);
-        gVolumeCounters.skipped.fetch_add(uint64_t(skipped), std::memory_order_relaxed);
+        tlsCounters.volumeSamples += samples;
+        tlsCounters.volumeSkipped += uint64_t(skipped);
         return r;
     }
 
@@ -251,5 +250,8 @@ struct VolumeIntegrator {
         }
     }
 };
+static_assert(Integrator<VolumeIntegrator, VolumeScene<uint8_t>>);
+static_assert(Integrator<VolumeIntegrator, VolumeScene<uint16_t>>);
+static_assert(Integrator<VolumeIntegrator, VolumeScene<float>>);
 
 }  // namespace rtfact::volume

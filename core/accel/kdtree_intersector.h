@@ -1,13 +1,9 @@
 // Generic packet traversal of a KdTree<Elem>. Each stack entry carries its cell, so
 // every lane's interval is recomputed exactly with the shared slab test; lanes whose
 // hit lies before a cell drop out, and cells are visited near to far. An element
-// intersector may answer an inner node itself (level-of-detail cuts) by providing
-//   bool innerNode<D>(const KdTree<Elem>&, uint32_t node, const AABB& cell,
-//                     const RayPacket<N>&, Hit<N>&, int firstChunk) const
-// which returns true when the node's subtree need not be visited. Structures whose
-// elements may reach beyond the split plane (discs stored once, by centre) can give
-// the children's cells themselves with
-//   void childCells(const KdTree<Elem>&, uint32_t node, const AABB& cell, AABB& lo, AABB& hi) const
+// intersector may answer an inner node itself (level-of-detail cuts, KdTreeInnerNodeHook)
+// and give the children's cells itself when its elements reach beyond the split plane
+// (KdTreeChildCellsHook); both hooks are named in core/concepts/intersector_hooks.h.
 // An empty `indices` list means the elements are stored in leaf order (first..first+count).
 #pragma once
 #include <new>
@@ -15,6 +11,7 @@
 #include "core/accel/kdtree.h"
 #include "core/accel/ray_box.h"
 #include "core/concepts/intersector.h"
+#include "core/concepts/intersector_hooks.h"
 #include "core/util/assert.h"
 
 namespace rtfact {
@@ -81,14 +78,14 @@ struct KdTreeIntersector {
                 }
                 continue;
             }
-            if constexpr (requires { elem.template innerNode<D>(tree, e.node, e.cell, rays, hit, k); }) {
+            if constexpr (KdTreeInnerNodeHook<ElemIsect, KdTree<Elem>, N>) {
                 if (elem.template innerNode<D>(tree, e.node, e.cell, rays, hit, k)) continue;
             }
             // The near child is popped next: start loading the children's pair now.
             __builtin_prefetch(&tree.nodes[node.left()]);
             const int axis = node.axis();
             Entry lo{e.cell, node.left(), uint32_t(k)}, hi{e.cell, node.left() + 1, uint32_t(k)};
-            if constexpr (requires { elem.childCells(tree, e.node, e.cell, lo.cell, hi.cell); }) {
+            if constexpr (KdTreeChildCellsHook<ElemIsect, KdTree<Elem>>) {
                 elem.childCells(tree, e.node, e.cell, lo.cell, hi.cell);
             } else {
                 lo.cell.hi[axis] = node.split;

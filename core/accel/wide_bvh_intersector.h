@@ -11,6 +11,8 @@
 
 #include "core/accel/wide_bvh.h"
 #include "core/concepts/intersector.h"
+#include "core/concepts/intersector_hooks.h"
+#include "core/geometry/sphere.h"
 #include "core/util/assert.h"
 
 namespace rtfact {
@@ -135,9 +137,7 @@ struct WideBVHIntersector {
                     break;
                 }
                 // Element intersectors may test a whole leaf at once (SIMD over elements).
-                if constexpr (requires {
-                                  elem.template intersectLeaf<D>(bvh.elems.data(), bvh.order.data(), 1, ray, hit);
-                              }) {
+                if constexpr (LeafIntersector<ElemIsect, Elem>) {
                     elem.template intersectLeaf<D>(bvh.elems.data() + e.child, bvh.order.data() + e.child, e.count, ray,
                                                    hit);
                 } else {
@@ -153,5 +153,9 @@ struct WideBVHIntersector {
         }
     }
 };
+
+// Checked here with the core's own element (surfaces/mesh_scene.h checks triangles).
+static_assert(Intersector<WideBVHIntersector<SphereIntersector>, WideBVH<Sphere, 4>>);
+static_assert(Intersector<WideBVHIntersector<SphereIntersector>, WideBVH<Sphere, 16>>);
 
 }  // namespace rtfact

@@ -22,4 +22,23 @@ concept GeometryScene = GeometrySceneAt<S, 1> && GeometrySceneAt<S, simd::kNativ
     { s.bounds() } -> std::convertible_to<AABB>;
 };
 
+// The least a GeometryScene offers (declarations only, never called). Integrators
+// written against the concept assert with it that they model Integrator for every
+// scene kind, next to their definition.
+struct GeometrySceneArchetype {
+    template <int N>
+    struct Hit {
+        Packet<N> t;
+        Packet<N, int32_t> id;
+    };
+    template <int N>
+    Hit<N> intersect(const RayPacket<N>&, const Mask<N>&) const;
+    template <int N>
+    Mask<N> occluded(const RayPacket<N>&, const Mask<N>&) const;
+    template <int N>
+    SurfacePoint<N> surface(const RayPacket<N>&, const Hit<N>&, const Mask<N>&) const;
+    AABB bounds() const;
+};
+static_assert(GeometryScene<GeometrySceneArchetype>);
+
 }  // namespace rtfact

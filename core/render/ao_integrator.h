@@ -25,7 +25,7 @@ struct AOIntegratorT {
     float offset = 1e-4f;
     float minDistance = 0.0f;
 
-    template <int N, class Scene>
+    template <int N, GeometryScene Scene>
     Radiance<N> eval(const Scene& scene, RayPacket<N>& rays, const Mask<N>& active, const PixelSample<N>& ps) const {
         PrimaryHit<N, Scene> ph;
         if (!tracePrimary(scene, rays, active, background, ph)) return ph.result;
@@ -50,6 +50,8 @@ struct AOIntegratorT {
         return ph.finish(sp.color * (open * Packet<N>(1.0f / float(std::max(samples, 1)))));
     }
 };
+static_assert(Integrator<AOIntegratorT<PacketSecondaryRays>, GeometrySceneArchetype> &&
+              Integrator<AOIntegratorT<WideSecondaryRays>, GeometrySceneArchetype>);
 using AOIntegrator = AOIntegratorT<>;
 
 }  // namespace rtfact

@@ -18,12 +18,13 @@ constexpr int packetBlockWidth(int n) {
     return n;
 }
 
-template <class S, class I>
+template <Sampler S, class I>
 struct RayTracingRenderer {
     S sampler{};
     I integrator{};
 
-    template <int N, class Scene, class Cam, class FB>
+    template <int N, class Scene, Camera Cam, Framebuffer FB>
+    requires Integrator<I, Scene>
     void render(const Scene& scene, const Cam& cam, FB& fb, Region region, int sample) const {
         constexpr int bw = packetBlockWidth(N), bh = N / bw;
         const Packet<N, int32_t> lx = laneOffsets<N>(bw, true), ly = laneOffsets<N>(bw, false);

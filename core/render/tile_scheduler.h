@@ -2,6 +2,7 @@
 // hands to worker threads dynamically (work stealing), for any number of samples.
 #pragma once
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -11,7 +12,7 @@
 #include <string>
 
 #include "core/concepts/renderer.h"
-#include "core/render/ray_stats.h"
+#include "core/render/render_counters.h"
 #include "core/util/progress.h"
 
 namespace rtfact {
@@ -32,24 +33,27 @@ struct RenderOptions {
 
 struct RenderStats {
     double ms = 0;
-    uint64_t rays = 0;
+    uint64_t rays = 0;  // counters.rays
     int threads = 0;
     bool cancelled = false;
+    RenderCounters counters;  // summed over every tile of the frame
 };
 
 inline int resolveThreads(int requested) { return requested > 0 ? requested : tbb::this_task_arena::max_concurrency(); }
 
 template <int N, class R, class Scene, class Cam, class FB>
-RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam, FB& fb, const RenderOptions& opt) {
+requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam,
+                                                             FB& fb, const RenderOptions& opt) {
     const int w = fb.width(), h = fb.height();
     const int ts = std::max(opt.tileSize, 1);
     const int tx = (w + ts - 1) / ts, ty = (h + ts - 1) / ts, tiles = tx * ty;
     const int spp = std::max(opt.spp, 1);
     RenderStats st;
     st.threads = resolveThreads(opt.threads);
-    std::atomic<uint64_t> rays{0}, done{0};
+    std::atomic<uint64_t> done{0};
     const uint64_t total = uint64_t(tiles) * uint64_t(spp);
     auto cancelled = [&] { return opt.cancel && opt.cancel->load(std::memory_order_relaxed); };
+    tbb::enumerable_thread_specific<RenderCounters> counted;
     Progress progress(opt.label, uint64_t(tiles) * uint64_t(spp), opt.progress);
     const auto t0 = std::chrono::steady_clock::now();
     tbb::task_arena arena(st.threads);
@@ -58,7 +62,7 @@ RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam, F
             tbb::parallel_for(
                 tbb::blocked_range<int>(0, tiles, 1),
                 [&](const tbb::blocked_range<int>& range) {
-                    const uint64_t before = tlsRaysTraced;
+                    const RenderCounters before = tlsCounters;
                     for (int t = range.begin(); t != range.end(); ++t) {
                         if (cancelled()) break;
                         const int x0 = (t % tx) * ts, y0 = (t / tx) * ts;
@@ -68,14 +72,15 @@ RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam, F
                         const uint64_t d = ++done;
                         if (opt.onTile) opt.onTile(d, total);
                     }
-                    rays += tlsRaysTraced - before;
+                    counted.local() += tlsCounters - before;
                 },
                 tbb::simple_partitioner());
         }
     });
     progress.finish();
     st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    st.rays = rays.load();
+    for (const RenderCounters& c : counted) st.counters += c;
+    st.rays = st.counters.rays;
     st.cancelled = cancelled() && done.load() < total;
     return st;
 }

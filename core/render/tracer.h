@@ -3,7 +3,7 @@
 // so domain scenes don't each repeat that plumbing.
 #pragma once
 #include "core/concepts/intersector.h"
-#include "core/render/ray_stats.h"
+#include "core/render/render_counters.h"
 
 namespace rtfact {
 
@@ -15,7 +15,7 @@ struct Tracer {
 
     template <HitData D = HitData::Shading, class Accel, int N>
     Hit<N> intersect(const Accel& accel, const RayPacket<N>& rays, const Mask<N>& active) const {
-        tlsRaysTraced += uint64_t(popcount(active));
+        tlsCounters.rays += uint64_t(popcount(active));
         Hit<N> hit;
         if (rays.commonOrigin)
             isect.template intersect<true, D>(accel, rays, hit, active);
@@ -25,7 +25,7 @@ struct Tracer {
     }
     template <class Accel, int N>
     Mask<N> occluded(const Accel& accel, const RayPacket<N>& rays, const Mask<N>& active) const {
-        tlsRaysTraced += uint64_t(popcount(active));
+        tlsCounters.rays += uint64_t(popcount(active));
         if (rays.commonOrigin) return isect.template occluded<true>(accel, rays, active);
         return isect.template occluded<false>(accel, rays, active);
     }

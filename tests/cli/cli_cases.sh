@@ -205,6 +205,13 @@ printf 'mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > pipes/withmtl.ob
 pipe_case pipes/lib.mtl mesh pipes/withmtl.obj --quiet -o hostile.png
 if [ -e hostile.png ]; then echo "FAIL: an image was written for a named-pipe input"; fails=$((fails + 1)); fi
 
+# Point clouds render with the core's Whitted and path integrators too.
+expect 0 "" -- points three.ply --integrator whitted --size 16x16 --quiet -o whitted.png
+expect 0 "" -- points three.ply --integrator path --spp 2 --size 16x16 --quiet -o path.png
+for img in whitted.png path.png; do
+  if [ "$(head -c 4 "$img" 2>/dev/null | od -An -c | tr -d ' ')" != "211PNG" ]; then echo "FAIL: $img not written"; fails=$((fails + 1)); fi
+done
+
 # Non-finite points are dropped with one warning line (none with --quiet); a cloud with
 # no finite point is an error.
 printf '0 0 0\n1 0 0\n0 1 0\nnan 0 0\n1 inf 0\n' > some_nan.xyz

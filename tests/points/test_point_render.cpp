@@ -48,14 +48,15 @@ constexpr int kSize = 160;
 
 template <class Integrator = EyeLightIntegrator>
 std::vector<float> render(const PointScene& scene, const CameraFrame& frame, float quality,
-                          const Integrator& integ = {}) {
+                          const Integrator& integ = {}, RenderStats* stats = nullptr) {
     const PinholeCamera cam(frame, kSize, kSize);
     const_cast<PointScene&>(scene).setLoD(cam.cone(), quality);
     RGBAFramebuffer fb(kSize, kSize);
     const RayTracingRenderer<PixelCenterSampler, Integrator> r{{}, integ};
     RenderOptions ro;
     ro.progress = false;
-    renderImage<64>(r, scene, cam, fb, ro);
+    const RenderStats st = renderImage<64>(r, scene, cam, fb, ro);
+    if (stats) *stats = st;
     return fb.resolved(1);
 }
 
@@ -94,12 +95,13 @@ TEST(PointRender, LoDStaysCloseToFullDetail) {
     PointScene scene;
     CameraFrame frame;
     ASSERT_TRUE(loadBunny(scene, frame));
-    const auto full = render(scene, frame, 0.0f);
-    const uint64_t before = scene.lodHits->load();
-    const auto lod = render(scene, frame, 4.0f);
+    RenderStats fullStats, lodStats;
+    const auto full = render(scene, frame, 0.0f, EyeLightIntegrator{}, &fullStats);
+    const auto lod = render(scene, frame, 4.0f, EyeLightIntegrator{}, &lodStats);
     const test::ImageDiff d = test::compareRGBA(lod, full, kSize, kSize, 8);
     EXPECT_GE(d.psnr, 30.0);
-    EXPECT_GT(scene.lodHits->load(), before);  // the cut was used
+    EXPECT_EQ(fullStats.counters.lodNodesHit, 0u);  // full detail: input discs only
+    EXPECT_GT(lodStats.counters.lodNodesHit, 0u);   // the cut was used
 }
 
 TEST(PointRender, PacketSizesAgree) {

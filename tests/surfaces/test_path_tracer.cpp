@@ -178,3 +178,19 @@ TEST(PathTracer, CornellMatchesReference) {
     test::expectMatchesReference(std::string(RTFACT_TEST_DATA) + "/mesh_path_cornell.png", 48, 48,
                                  render<64>(scene, integ, f, 48, 48, 64));
 }
+
+// Glass needs the side a ray arrives from; meshes report it from the triangle winding
+// (outward for closed meshes), so the integrators never look at the mesh themselves.
+TEST(PathTracer, MeshReportsTheSideTheRayArrivesFrom) {
+    const MeshScene<BVH<Triangle>> scene(std::make_shared<const Mesh>(flatCube()));
+    auto arrive = [&](Vec3f org) {
+        RayPacket<1> ray;
+        ray.setLane(0, org, {0.0f, 0.0f, -1.0f});
+        ray.finalize();
+        const auto hit = scene.intersect<1>(ray, Mask<1>(true));
+        EXPECT_GE(hit.id[0], 0);
+        return scene.surface<1>(ray, hit, Mask<1>(true)).front[0];
+    };
+    EXPECT_TRUE(arrive({0.1f, 0.2f, 5.0f}));   // from outside
+    EXPECT_FALSE(arrive({0.1f, 0.2f, 0.0f}));  // from inside
+}

@@ -96,11 +96,10 @@ Rendered render(const VolumeGrid& g, const TransferFunction& tf, VolumeRenderSet
         RenderOptions ro;
         ro.threads = 2;
         ro.progress = false;
-        gVolumeCounters.reset();
-        renderImage<N>(r, scene, cam, fb, ro);
+        const RenderStats st = renderImage<N>(r, scene, cam, fb, ro);
         out.rgba = fb.resolved(1);
-        out.samples = gVolumeCounters.samples;
-        out.skipped = gVolumeCounters.skipped;
+        out.samples = st.counters.volumeSamples;
+        out.skipped = st.counters.volumeSkipped;
     });
     return out;
 }
