@@ -30,7 +30,7 @@
 #include "core/render/random.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
-#include "surfaces/mesh_loader.h"
+#include "engine/built_scene.h"
 #include "surfaces/mesh_scene.h"
 
 namespace rtfact::bench {
@@ -529,7 +529,11 @@ int benchMesh(int argc, char** argv) {
     if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 16 || h < 16 || w > 16384 || h > 16384 || w % 16 ||
         h % 16)
         throw Error("", "--size: expected WxH, multiples of 16 in 16..16384");
-    Mesh mesh = loadMesh(file);
+    // Loading (every format, several files merged) is the engine's, as for `rtfact mesh`.
+    engine::OpenOptions oo;
+    oo.kind = engine::SceneKind::Mesh;
+    oo.progress = false;
+    Mesh mesh = *engine::loadedMesh(engine::open({file}, oo));
     if (grid > 1) {
         // Copies side by side (shadowing each other) on a ground quad.
         const Mesh one = mesh;

@@ -26,9 +26,10 @@
 #include "core/render/pinhole_camera.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/util/error.h"
+#include "core/util/huge_pages.h"
 #include "core/util/progress.h"
-#include "points/huge_pages.h"
-#include "points/point_cloud_io.h"
+#include "engine/built_scene.h"
+#include "engine/render_session.h"
 #include "points/point_scene.h"
 
 namespace rtfact::bench {
@@ -167,15 +168,17 @@ double psnr8(const Frame& a, const Frame& b) {
 }
 
 template <int N>
-int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& cam, int w, int h, int all, int repeat,
-        std::vector<float> qualities, std::vector<float> repScales, int leafSize, double loadMs) {
+int run(const std::string& file, std::shared_ptr<PointScene> built, const PinholeCamera& cam, int w, int h, int all,
+        int repeat, std::vector<float> qualities, std::vector<float> repScales, int leafSize, double loadMs) {
     const float quality = qualities.front();
+    // The engine's scene renders; the rebuilds below only time the builder on its discs.
+    PointScene& scene = *built;
+    std::vector<Disc> discs = scene.tree.elems;
     const size_t n = discs.size();
     std::printf(
         "file=%s\npoints=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nrep_scale=%.3g\nload_ms=%.1f\n",
         file.c_str(), n, w, h, N, all, quality, repScales.front(), loadMs);
     const std::vector<int> threadCounts = all > 1 ? std::vector<int>{1, all} : std::vector<int>{1};
-    PointScene scene;
     LoDKdTreeBuilder builder;
     builder.maxLeafSize = leafSize;
     double rtBuild = 1e30;
@@ -184,15 +187,15 @@ int run(const std::string& file, std::vector<Disc> discs, const PinholeCamera& c
         tbb::task_arena arena(all);
         for (int r = 0; r < std::max(1, std::min(repeat, 2)); ++r) {
             std::vector<Disc> copy;
-            resizeHuge(copy, discs.size());
+            resizeFreshHugePages(copy, discs.size());
             std::copy(discs.begin(), discs.end(), copy.begin());
+            PointScene rebuilt;
             const auto t0 = Clock::now();
-            arena.execute([&] { scene.build(std::move(copy), builder); });
+            arena.execute([&] { rebuilt.build(std::move(copy), builder); });
             rtBuild = std::min(rtBuild, msSince(t0));
         }
     }
     // Embree gets the same discs in the same (leaf) order.
-    discs = scene.tree.elems;
     EmbreeSide em(discs, cam, all);
     double emBuild = 1e30;
     {
@@ -296,33 +299,37 @@ int benchPoints(int argc, char** argv) {
         h % 16)
         throw Error("", "--size: expected WxH, multiples of 16 in 16..16384");
     setProgressEnabled(false);
+    // Loading, preparation (normals, radii, colours) and the build are the engine's, as
+    // for `rtfact points`; the camera is the CLI's default view unless given.
+    engine::OpenOptions oo;
+    oo.kind = engine::SceneKind::Points;
+    oo.progress = false;
+    oo.keepSource = false;
     const auto t0 = Clock::now();
-    PointCloud cloud = loadPointCloud(file);
+    const engine::Scene sc = engine::open({file}, oo);
     const double loadMs = msSince(t0);
-    CameraFrame frame = fitCamera(cloud.bounds(), fov, float(w) / float(h));
+    engine::Settings settings;
+    settings.points.normals = normals;
+    settings.points.radius = radius;
+    settings.points.radiusFactor = radiusFactor;
+    settings.points.leafSize = leafSize;
+    CameraFrame frame = engine::fitCamera(sc.defaultView(settings), fov, float(w) / float(h));
     if (!eye.empty()) frame.eye = parseVec(eye, "--eye");
     if (!at.empty()) frame.at = parseVec(at, "--at");
     if (!up.empty()) frame.up = parseVec(up, "--up");
     frame.fovDeg = fov;
     const PinholeCamera cam(frame, w, h);
-    PrepareOptions po;
-    po.normals = normals;
-    po.radius = radius;
-    po.radiusFactor = radiusFactor;
-    po.viewpoint = frame.eye;
-    preparePointCloud(cloud, po, file);
-    std::vector<Disc> discs = makeDiscs(cloud, ColorMode::Rgb);
-    cloud = PointCloud{};
+    std::shared_ptr<PointScene> scene = engine::builtPoints(sc, settings, frame);
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
     switch (packet) {
         case 1:
-            return run<1>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<1>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
         case 16:
-            return run<16>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<16>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
         case 256:
-            return run<256>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<256>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
         default:
-            return run<64>(file, std::move(discs), cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<64>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
     }
 }
 

@@ -22,18 +22,13 @@
 
 #include "bench/bench_commands.h"
 #include "bench/bench_common.h"
-#include "core/render/framebuffer.h"
 #include "core/render/image_io.h"
-#include "core/render/packet_dispatch.h"
 #include "core/render/pinhole_camera.h"
-#include "core/render/pixel_center_sampler.h"
-#include "core/render/ray_tracing_renderer.h"
-#include "core/render/tile_scheduler.h"
 #include "core/util/error.h"
+#include "engine/built_scene.h"
+#include "engine/render_session.h"
 #include "volume/transfer_function.h"
-#include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
-#include "volume/volume_scene.h"
 
 namespace rtfact::bench {
 namespace {
@@ -92,15 +87,16 @@ struct VdbMarcher {
     }
 };
 
-openvdb::FloatGrid::Ptr denseToVdb(const VolumeGrid& g, const TFTable& tf) {
+openvdb::FloatGrid::Ptr toVdb(const BrickedVolume& v, const TFTable& tf) {
     // Stored values; active where the TF makes the voxel visible.
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
     auto acc = grid->getAccessor();
-    for (int k = 0; k < g.dims[2]; ++k)
-        for (int j = 0; j < g.dims[1]; ++j)
-            for (int i = 0; i < g.dims[0]; ++i) {
-                const size_t n = g.index(i, j, k);
-                if (tf.a[size_t(tf.index(g.value(n)))] > 0) acc.setValue(openvdb::Coord(i, j, k), g.stored(n));
+    for (int k = 0; k < v.dims[2]; ++k)
+        for (int j = 0; j < v.dims[1]; ++j)
+            for (int i = 0; i < v.dims[0]; ++i) {
+                const float stored = v.stored(i, j, k);
+                if (tf.a[size_t(tf.index(stored * v.scale + v.offset))] > 0)
+                    acc.setValue(openvdb::Coord(i, j, k), stored);
             }
     return grid;
 }
@@ -139,47 +135,51 @@ int benchVolume(int argc, char** argv) {
     }
     int w = 0, h = 0;
     if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) throw Error("--size", "expected WxH");
-    VolumeLoadOptions lo;
-    if (!dims.empty()) lo.dims = parseDims(dims);
-    lo.type = type;
-    lo.progress = false;
+    // Loading, the default view, the TF and window and the volume scene are the engine's,
+    // as for `rtfact volume`; the peer gets the same bricks, TF table and camera.
+    engine::OpenOptions oo;
+    oo.kind = engine::SceneKind::Volume;
+    oo.progress = false;
+    if (!dims.empty()) oo.volume.dims = parseDims(dims);
+    oo.volume.type = type;
+    oo.volume.progress = false;
     const bool isVdb = dims.empty() && file.size() > 4 && file.substr(file.size() - 4) == ".vdb";
     auto t0 = Clock::now();
-    VolumeGrid g;
-    BrickedVolume vol;
-    if (isVdb)
-        vol = loadVDBBricked(file, lo);  // sparse: never densified
-    else
-        g = loadVolume(file, lo);
+    engine::Scene sc = engine::open({file}, oo);
     const double loadMs = msSince(t0);
-    t0 = Clock::now();
-    if (!isVdb) vol = brickVolume(g);
-    if (std::fabs(vol.spacing.x - vol.spacing.y) > 1e-6f || std::fabs(vol.spacing.x - vol.spacing.z) > 1e-6f) {
-        std::printf(
-            "note: anisotropic spacing; both renderers use isotropic spacing %g here (OpenVDB's intersector needs "
-            "uniform voxels)\n",
-            double(minComponent(vol.spacing)));
-        vol.spacing = g.spacing = Vec3f(minComponent(vol.spacing));
+    {
+        const Vec3f sp = engine::builtVolume(sc, {}).volume->spacing;
+        if (std::fabs(sp.x - sp.y) > 1e-6f || std::fabs(sp.x - sp.z) > 1e-6f) {
+            std::printf(
+                "note: anisotropic spacing; both renderers use isotropic spacing %g here (OpenVDB's intersector "
+                "needs uniform voxels)\n",
+                double(minComponent(sp)));
+            oo.volume.spacing = Vec3f(minComponent(sp));
+            sc = engine::open({file}, oo);
+        }
     }
-    const auto range = vol.valueRange();
-    const TransferFunction tf = resolveTransferFunction(tfName);
-    const auto win = resolveWindow(tf, range.first, range.second, window, level);
-    const TFTable table = buildTable(tf, win, step);
-    VolumeRenderSettings rs;
-    rs.stepVoxels = step;
+    engine::Settings settings;
+    settings.volume.tf = resolveTransferFunction(tfName);
+    settings.volume.window = window;
+    settings.volume.level = level;
+    settings.volume.step = step;
+    t0 = Clock::now();
+    const engine::BuiltVolume built = engine::builtVolume(sc, settings);
     const double buildMs = msSince(t0);
-    const AABB box = vol.bounds();
-    CameraFrame frame = fitCamera(box, fov, float(w) / float(h), {0.45f, -1.0f, 0.35f}, {0, 0, 1});
+    const BrickedVolume& vol = *built.volume;
+    const TFTable& table = built.setup.table;
+    const auto win = built.setup.window;
+    CameraFrame frame = engine::fitCamera(sc.defaultView(settings), fov, float(w) / float(h));
     if (!eye.empty()) frame.eye = parseVec(eye, "--eye");
     if (!at.empty()) frame.at = parseVec(at, "--at");
     if (!up.empty()) frame.up = parseVec(up, "--up");
     const PinholeCamera cam(frame, w, h);
     const int allThreads = resolveThreads(threads);
-    std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, bricks+TF %.0f ms\n",
+    std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, TF %.0f ms\n",
                 file.c_str(), vol.dims[0], vol.dims[1], vol.dims[2], storageName(vol.storage), vol.sourceType.c_str(),
                 vol.storedBricks(), vol.brickCount(), double(vol.memoryBytes()) / 1048576.0, loadMs, buildMs);
     std::printf("view %dx%d, tf %s window [%g, %g], step %g voxels, packet %d, frames %d (best reported)\n", w, h,
-                tf.name.c_str(), double(win.first), double(win.second), double(step), packet, frames);
+                built.setup.tf.name.c_str(), double(win.first), double(win.second), double(step), packet, frames);
 
     struct Result {
         double ms = 0;
@@ -187,21 +187,20 @@ int benchVolume(int argc, char** argv) {
     };
     std::vector<float> ourImage;
     auto runOurs = [&](int th) {
+        // One 1-sample pass per frame: the session's first sample is the pixel centre.
+        engine::FrameOptions fo;
+        fo.width = w;
+        fo.height = h;
+        fo.packet = packet;
+        fo.threads = th;
+        engine::RenderSession session(sc, settings, fo, frame);
         Result best{1e300, 0};
-        withVolumeScene(vol, table, rs, [&](const auto& scene) {
-            const RayTracingRenderer<PixelCenterSampler, VolumeIntegrator> renderer{};
-            for (int f = 0; f < frames; ++f) {
-                RGBAFramebuffer fb(w, h);
-                RenderOptions ro;
-                ro.threads = th;
-                ro.progress = false;
-                RenderStats st;
-                if (!dispatchPacketSize(packet, [&]<int N>() { st = renderImage<N>(renderer, scene, cam, fb, ro); }))
-                    throw Error("--packet", "unsupported packet size");
-                if (st.ms < best.ms) best = {st.ms, st.counters.volumeSamples};
-                if (f == 0) ourImage = fb.resolved(1);
-            }
-        });
+        for (int f = 0; f < frames; ++f) {
+            session.setCamera(frame);  // restarts the accumulation
+            const engine::PassResult pr = session.renderPass();
+            if (pr.render.ms < best.ms) best = {pr.render.ms, pr.render.counters.volumeSamples};
+            if (f == 0) ourImage = session.frame().rgba;
+        }
         return best;
     };
 
@@ -239,7 +238,7 @@ int benchVolume(int argc, char** argv) {
             }
             f.close();
         } else {
-            peer.grid = denseToVdb(g, table);
+            peer.grid = toVdb(vol, table);
         }
         if (!peer.grid) throw Error(file, "no float grid for the OpenVDB peer");
         openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(double(vol.spacing.x));
@@ -254,7 +253,7 @@ int benchVolume(int argc, char** argv) {
         peer.tfMul = vol.scale * k;
         peer.tfAdd = (vol.offset - table.lo) * k + 0.5f;
         peer.step = step;
-        peer.term = rs.earlyTermination;
+        peer.term = built.setup.render.earlyTermination;
         std::printf("openvdb grid: %llu active voxels, built in %.0f ms\n",
                     (unsigned long long)peer.grid->activeVoxelCount(), msSince(t0));
     }

@@ -7,6 +7,7 @@
 #include "core/render/ao_integrator.h"
 #include "core/render/direct_light_integrator.h"
 #include "core/render/eyelight_integrator.h"
+#include "engine/built_scene.h"
 #include "engine/renderable.h"
 #include "surfaces/mesh_scene.h"
 #include "surfaces/path_integrator.h"
@@ -177,4 +178,12 @@ std::unique_ptr<Renderable> makeMeshRenderable(SceneData& d, const MeshSettings&
 }
 
 }  // namespace detail
+
+std::shared_ptr<const Mesh> loadedMesh(const Scene& scene) {
+    detail::SceneData& d = *scene.data;
+    if (d.kind != SceneKind::Mesh) throw UsageError("scene", "loadedMesh needs a mesh");
+    std::lock_guard lock(d.mutex);
+    if (!d.mesh.mesh) throw UsageError("scene", "the mesh was released after the build (open with keepSource)");
+    return d.mesh.mesh;
+}
 }  // namespace rtfact::engine

@@ -7,6 +7,7 @@
 #include "core/render/eyelight_integrator.h"
 #include "core/render/path_integrator.h"
 #include "core/render/whitted_integrator.h"
+#include "engine/built_scene.h"
 #include "engine/renderable.h"
 #include "points/point_scene.h"
 
@@ -48,9 +49,8 @@ std::unique_ptr<Renderable> make(std::shared_ptr<PointScene> scene, I integ, con
 
 }  // namespace
 
-std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSettings& s, const CameraFrame& frame,
-                                                Stats& stats) {
-    requireName(pointIntegrators(), s.integrator, "--integrator");
+std::shared_ptr<PointScene> buildPointScene(SceneData& d, const PointSettings& s, const CameraFrame& frame,
+                                            Stats& stats) {
     PointData& pd = d.points;
     const std::string prepareKey = s.normals + "|" + std::to_string(s.radius) + "|" + std::to_string(s.radiusFactor);
     const std::string buildKey = prepareKey + "|" + std::to_string(int(s.color)) + "|" + std::to_string(s.leafSize);
@@ -97,7 +97,13 @@ std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSetting
         pd.scene = scene;
         pd.buildKey = buildKey;
     }
-    auto scene = std::static_pointer_cast<PointScene>(pd.scene);
+    return std::static_pointer_cast<PointScene>(pd.scene);
+}
+
+std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSettings& s, const CameraFrame& frame,
+                                                Stats& stats) {
+    requireName(pointIntegrators(), s.integrator, "--integrator");
+    auto scene = buildPointScene(d, s, frame, stats);
     if (s.integrator == "eyelight") return make(scene, EyeLightIntegrator{}, s);
     if (s.integrator == "ao") {
         AOIntegrator ao;
@@ -135,4 +141,14 @@ std::unique_ptr<Renderable> makePointRenderable(SceneData& d, const PointSetting
 }
 
 }  // namespace detail
+
+std::shared_ptr<points::PointScene> builtPoints(const Scene& scene, const Settings& settings, const CameraFrame& frame,
+                                                Stats* stats) {
+    detail::SceneData& d = *scene.data;
+    if (d.kind != SceneKind::Points) throw UsageError("scene", "builtPoints needs a point cloud");
+    std::lock_guard lock(d.mutex);
+    Stats ignored;
+    return detail::buildPointScene(d, settings.points, frame, stats ? *stats : ignored);
+}
+
 }  // namespace rtfact::engine

@@ -3,6 +3,7 @@
 // per storage type.
 #include <chrono>
 
+#include "engine/built_scene.h"
 #include "engine/renderable.h"
 #include "volume/default_transfer_function.h"
 #include "volume/value_histogram.h"
@@ -51,10 +52,8 @@ std::unique_ptr<Renderable> make(const BrickedVolume& v, const TFTable& table, c
 
 }  // namespace
 
-std::unique_ptr<Renderable> makeVolumeRenderable(SceneData& d, const VolumeSettings& s, Stats& stats) {
+VolumeSetup resolveVolumeSetup(const BrickedVolume& vol, const VolumeSettings& s, Stats& stats) {
     requireName(volumeModes(), s.mode, "--mode");
-    const BrickedVolume& vol = d.volume.vol;
-    const auto t0 = std::chrono::steady_clock::now();
     VolumeRenderSettings rs;
     rs.mode = modeOf(s.mode);
     rs.stepVoxels = s.step;
@@ -74,8 +73,18 @@ std::unique_ptr<Renderable> makeVolumeRenderable(SceneData& d, const VolumeSetti
         window = s.window || s.level ? resolveWindow(tf, lo, hi, s.window, s.level) : dt.window;
         stats.add("tf_default", dt.describe());
     }
-    const TFTable table = buildTable(tf, window, s.step);
     rs.iso = s.iso ? *s.iso : defaultIso(lo, hi);
+    return {rs, tf, window, buildTable(tf, window, s.step)};
+}
+
+std::unique_ptr<Renderable> makeVolumeRenderable(SceneData& d, const VolumeSettings& s, Stats& stats) {
+    const BrickedVolume& vol = d.volume.vol;
+    const auto t0 = std::chrono::steady_clock::now();
+    const VolumeSetup vs = resolveVolumeSetup(vol, s, stats);
+    const VolumeRenderSettings& rs = vs.render;
+    const TransferFunction& tf = vs.tf;
+    const std::pair<float, float> window = vs.window;
+    const TFTable& table = vs.table;
     stats.add("voxels", (unsigned long long)vol.voxelCount());
     stats.add("bricks_stored", (unsigned long long)vol.storedBricks());
     stats.add("memory_mb", double(vol.memoryBytes()) / 1048576.0);
@@ -96,4 +105,12 @@ std::unique_ptr<Renderable> makeVolumeRenderable(SceneData& d, const VolumeSetti
 }
 
 }  // namespace detail
+
+BuiltVolume builtVolume(const Scene& scene, const Settings& settings, Stats* stats) {
+    const detail::SceneData& d = *scene.data;
+    if (d.kind != SceneKind::Volume) throw UsageError("scene", "builtVolume needs a volume");
+    Stats ignored;
+    return {&d.volume.vol, detail::resolveVolumeSetup(d.volume.vol, settings.volume, stats ? *stats : ignored)};
+}
+
 }  // namespace rtfact::engine

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/util/error.h"
-#include "points/huge_pages.h"
+#include "core/util/huge_pages.h"
 #include "points/lod_kdtree.h"
 
 namespace rtfact::points {
@@ -147,8 +147,8 @@ LoDKdTree LoDKdTreeBuilder::build(std::vector<Disc> discs) const {
     if (discs.size() >= (size_t(1) << 29)) throw Error("", "too many points for one tree (limit 2^29)");
     Ctx ctx{&t, discs.data(), size_t(std::max(1, maxLeafSize)), {}};
     const uint32_t total = 1 + ctx.computeDesc(discs.size());
-    resizeHuge(t.nodes, total);
-    resizeHuge(t.inner, (total - 1) / 2);
+    resizeFreshHugePages(t.nodes, total);
+    resizeFreshHugePages(t.inner, (total - 1) / 2);
     AABB cell;
     for (const Disc& d : discs) cell.extend(d.center);
     const Agg a = buildNode(ctx, discs.data(), discs.size(), cell, 0, 1);

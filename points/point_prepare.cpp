@@ -19,7 +19,7 @@
 #include "core/util/error.h"
 #include "core/util/memory_budget.h"
 #include "core/util/progress.h"
-#include "points/huge_pages.h"
+#include "core/util/huge_pages.h"
 
 namespace rtfact::points {
 
@@ -240,7 +240,7 @@ ColorMode parseColorMode(const std::string& s) {
 std::vector<Disc> makeDiscs(const PointCloud& c, ColorMode mode) {
     const size_t n = c.size();
     std::vector<Disc> d;
-    resizeHuge(d, n);
+    resizeFreshHugePages(d, n);
     float iLo = 0, iHi = 1;
     if (mode == ColorMode::Intensity && c.intensities.size() == n) {
         iLo = *std::min_element(c.intensities.begin(), c.intensities.end());

@@ -33,4 +33,13 @@ void resizeHugePages(std::vector<T, A>& v, size_t n) {
     v.resize(n);
 }
 
+// A vector of n fresh elements on huge pages: its old memory is given back first, since
+// the advice only helps pages not yet touched.
+template <class T, class A>
+void resizeFreshHugePages(std::vector<T, A>& v, size_t n) {
+    v.clear();
+    v.shrink_to_fit();
+    resizeHugePages(v, n);
+}
+
 }  // namespace rtfact
