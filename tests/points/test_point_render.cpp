@@ -1,5 +1,5 @@
 // Image regression on the shipped real scan (Stanford Bunny range scan bun000): the full
-// pipeline (PLY load, PCL normals, spacing radii, LoD tree, eyelight) against a
+// pipeline (the engine's PLY load, PCL normals, spacing radii, LoD tree; eyelight) against a
 // reference PNG. Metric (tests/common/image_compare.h): 8-bit sRGB; at most 0.5% of
 // pixels may differ by more than 8/255 in a channel and PSNR must be >= 35 dB.
 // Also: LoD at quality 4 stays >= 30 dB PSNR from full detail on the same view; packet
@@ -17,7 +17,7 @@
 #include "core/render/pixel_center_sampler.h"
 #include "core/render/ray_tracing_renderer.h"
 #include "core/render/tile_scheduler.h"
-#include "points/point_cloud_io.h"
+#include "engine/built_scene.h"
 #include "points/point_scene.h"
 
 using namespace rtfact;
@@ -29,20 +29,21 @@ namespace {
 constexpr int kSize = 160;
 
 // The scan is tracked in datasets/: missing, it is a failure (callers ASSERT_TRUE).
-[[nodiscard]] bool loadBunny(PointScene& scene, CameraFrame& frame, ColorMode mode = ColorMode::Rgb) {
+// Loaded, prepared and built by the engine, as `rtfact points` does.
+[[nodiscard]] bool loadBunny(std::shared_ptr<PointScene>& scene, CameraFrame& frame, ColorMode mode = ColorMode::Rgb) {
     const fs::path f = fs::path(RTFACT_POINTS_DATA) / "bunny_bun000.ply";
     if (!fs::exists(f)) {
         ADD_FAILURE() << "tracked dataset missing: " << f;
         return false;
     }
-    PointCloud c = loadPointCloud(f.string());
-    frame = fitCamera(c.bounds(), 40.0f, 1.0f, {0.0f, 0.1f, 1.0f});
-    PrepareOptions po;
-    po.viewpoint = frame.eye;
-    po.threads = 2;
-    preparePointCloud(c, po, f.string());
-    scene.colorMode = mode;
-    scene.build(makeDiscs(c, mode));
+    engine::OpenOptions oo;
+    oo.kind = engine::SceneKind::Points;
+    oo.progress = false;
+    const engine::Scene sc = engine::open({f.string()}, oo);
+    frame = fitCamera(sc.bounds(), 40.0f, 1.0f, {0.0f, 0.1f, 1.0f});
+    engine::Settings settings;
+    settings.points.color = mode;
+    scene = engine::builtPoints(sc, settings, frame);
     return true;
 }
 
@@ -64,40 +65,40 @@ std::vector<float> render(const PointScene& scene, const CameraFrame& frame, flo
 
 // The core's direct-light (with shadow rays) and AO integrators on discs, and the LoD cut.
 TEST(PointRender, DirectAOAndLoDMatchReferences) {
-    PointScene scene;
+    std::shared_ptr<PointScene> scene;
     CameraFrame frame;
     ASSERT_TRUE(loadBunny(scene, frame));
     const std::string dir = RTFACT_TEST_DATA;
     DirectLightIntegrator direct;
-    const AABB b = scene.bounds();
+    const AABB b = scene->bounds();
     direct.lights.push_back(
         PointLight{frame.eye + Vec3f(0, 1, 0) * length(b.extent()), Vec3f(2.5f * dot(b.extent(), b.extent()))});
     direct.lights.push_back(DirectionalLight{{0.3f, -1.0f, -0.4f}, Vec3f(0.5f)});
-    test::expectMatchesReference(dir + "/bunny_bun000_direct.png", kSize, kSize, render(scene, frame, 0.0f, direct));
+    test::expectMatchesReference(dir + "/bunny_bun000_direct.png", kSize, kSize, render(*scene, frame, 0.0f, direct));
     AOIntegrator ao;
     ao.samples = 8;
     ao.offset = 4e-3f;
     ao.minDistance = 4e-3f;
-    test::expectMatchesReference(dir + "/bunny_bun000_ao.png", kSize, kSize, render(scene, frame, 0.0f, ao));
+    test::expectMatchesReference(dir + "/bunny_bun000_ao.png", kSize, kSize, render(*scene, frame, 0.0f, ao));
     // A coarse cut (quality 8) answers many rays with inner-node splats: its own reference.
-    test::expectMatchesReference(dir + "/bunny_bun000_lod8.png", kSize, kSize, render(scene, frame, 8.0f));
+    test::expectMatchesReference(dir + "/bunny_bun000_lod8.png", kSize, kSize, render(*scene, frame, 8.0f));
 }
 
 TEST(PointRender, BunnyScanMatchesReference) {
-    PointScene scene;
+    std::shared_ptr<PointScene> scene;
     CameraFrame frame;
     ASSERT_TRUE(loadBunny(scene, frame));
-    const auto img = render(scene, frame, 0.0f);
+    const auto img = render(*scene, frame, 0.0f);
     test::expectMatchesReference(std::string(RTFACT_TEST_DATA) + "/bunny_bun000_eyelight.png", kSize, kSize, img);
 }
 
 TEST(PointRender, LoDStaysCloseToFullDetail) {
-    PointScene scene;
+    std::shared_ptr<PointScene> scene;
     CameraFrame frame;
     ASSERT_TRUE(loadBunny(scene, frame));
     RenderStats fullStats, lodStats;
-    const auto full = render(scene, frame, 0.0f, EyeLightIntegrator{}, &fullStats);
-    const auto lod = render(scene, frame, 4.0f, EyeLightIntegrator{}, &lodStats);
+    const auto full = render(*scene, frame, 0.0f, EyeLightIntegrator{}, &fullStats);
+    const auto lod = render(*scene, frame, 4.0f, EyeLightIntegrator{}, &lodStats);
     const test::ImageDiff d = test::compareRGBA(lod, full, kSize, kSize, 8);
     EXPECT_GE(d.psnr, 30.0);
     EXPECT_EQ(fullStats.counters.lodNodesHit, 0u);  // full detail: input discs only
@@ -105,7 +106,7 @@ TEST(PointRender, LoDStaysCloseToFullDetail) {
 }
 
 TEST(PointRender, PacketSizesAgree) {
-    PointScene scene;
+    std::shared_ptr<PointScene> scene;
     CameraFrame frame;
     ASSERT_TRUE(loadBunny(scene, frame));
     const PinholeCamera cam(frame, 64, 64);
@@ -114,12 +115,12 @@ TEST(PointRender, PacketSizesAgree) {
         const RayTracingRenderer<PixelCenterSampler, EyeLightIntegrator> r{{}, {}};
         RenderOptions ro;
         ro.progress = false;
-        renderImage<N>(r, scene, cam, fb, ro);
+        renderImage<N>(r, *scene, cam, fb, ro);
         return fb.resolved(1);
     };
     // Full detail: the same discs for every packet size, so the core's tolerance
     // (tests/core/test_render.cpp: last-bit differences only).
-    scene.setLoD(cam.cone(), 0.0f);
+    scene->setLoD(cam.cone(), 0.0f);
     const auto full1 = renderN.template operator()<1>();
     for (const auto& other : {renderN.template operator()<simd::kNativeWidth>(), renderN.template operator()<256>()}) {
         const test::ImageDiff d = test::compareRGBA(full1, other, 64, 64, 1);
@@ -127,7 +128,7 @@ TEST(PointRender, PacketSizesAgree) {
         EXPECT_GE(d.psnr, 50.0);
     }
     // With LoD on, decisions are per packet (first active ray), so packet sizes may differ slightly.
-    scene.setLoD(cam.cone(), 1.0f);
+    scene->setLoD(cam.cone(), 1.0f);
     const auto a = renderN.template operator()<1>();
     const auto b = renderN.template operator()<simd::kNativeWidth>();
     const auto c = renderN.template operator()<256>();
