@@ -34,6 +34,8 @@
 #include "surfaces/mesh_scene.h"
 
 namespace rtfact::bench {
+
+using namespace rtfact::surfaces;
 namespace {
 
 // What both tracers produce per pixel, so their results can be compared.

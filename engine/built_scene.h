@@ -22,7 +22,7 @@ std::shared_ptr<points::PointScene> builtPoints(const Scene& scene, const Settin
                                                 Stats* stats = nullptr);
 
 // The loaded mesh (several files merged). Needs the scene opened with keepSource.
-std::shared_ptr<const Mesh> loadedMesh(const Scene& scene);
+std::shared_ptr<const surfaces::Mesh> loadedMesh(const Scene& scene);
 
 // What a volume render of `settings.volume` uses: the transfer function (given or chosen
 // from the data), the window, the TF table and the march settings.

@@ -13,6 +13,8 @@
 
 namespace rtfact::engine {
 
+using namespace rtfact::surfaces;
+
 namespace {
 
 using Lines = std::vector<std::pair<std::string, std::string>>;

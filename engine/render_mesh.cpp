@@ -15,6 +15,8 @@
 
 namespace rtfact::engine {
 
+using namespace rtfact::surfaces;
+
 const std::vector<std::string>& meshIntegrators() {
     static const std::vector<std::string> names{"eyelight", "direct", "whitted", "ao", "path"};
     return names;

@@ -16,6 +16,8 @@
 
 namespace rtfact::engine {
 
+using namespace rtfact::surfaces;
+
 using detail::SceneData;
 
 namespace {

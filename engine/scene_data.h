@@ -23,10 +23,10 @@ struct PointData {
 };
 
 struct MeshData {
-    std::shared_ptr<Mesh> mesh;  // as loaded; released after the build unless keepSource
+    std::shared_ptr<surfaces::Mesh> mesh;  // as loaded; released after the build unless keepSource
     std::string buildKey;
-    std::shared_ptr<void> scene;           // MeshScene<BVH<Triangle>> or MeshScene<KdTree<Triangle>>
-    std::shared_ptr<const Mesh> rendered;  // the mesh the scene was built from
+    std::shared_ptr<void> scene;                     // MeshScene<BVH<Triangle>> or MeshScene<KdTree<Triangle>>
+    std::shared_ptr<const surfaces::Mesh> rendered;  // the mesh the scene was built from
 };
 
 struct VolumeData {

@@ -36,10 +36,10 @@ struct LightSpec {
 };
 
 struct MeshSettings {
-    std::string integrator = "direct";     // meshIntegrators()
-    std::vector<LightSpec> lights;         // empty: a key light above and left of the camera
-    std::optional<MeshMaterial> material;  // replaces every material (see materialOverride)
-    std::string bvh = "sah";               // sah|kdtree
+    std::string integrator = "direct";               // meshIntegrators()
+    std::vector<LightSpec> lights;                   // empty: a key light above and left of the camera
+    std::optional<surfaces::MeshMaterial> material;  // replaces every material (see materialOverride)
+    std::string bvh = "sah";                         // sah|kdtree
     int aoSamples = 16;
     int maxDepth = 6;
     std::string secondary = "auto";  // traversal of AO / bounce rays: auto|wide|packet
@@ -73,8 +73,8 @@ const std::vector<std::string>& volumeModes();
 const std::vector<std::string>& spheresIntegrators();
 
 // lambert[:kd] | mirror[:ks] | glass[:ior]: the replacement material of --material.
-MeshMaterial lambertMaterial(std::optional<Vec3f> kd = std::nullopt);
-MeshMaterial mirrorMaterial(std::optional<Vec3f> ks = std::nullopt);
-MeshMaterial glassMaterial(float ior = 1.5f);
+surfaces::MeshMaterial lambertMaterial(std::optional<Vec3f> kd = std::nullopt);
+surfaces::MeshMaterial mirrorMaterial(std::optional<Vec3f> ks = std::nullopt);
+surfaces::MeshMaterial glassMaterial(float ior = 1.5f);
 
 }  // namespace rtfact::engine

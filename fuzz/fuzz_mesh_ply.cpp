@@ -13,7 +13,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     try {
         const rtfact::io::MappedFile f(path);
         const auto header = rtfact::io::readPlyHeader(f);
-        const auto mesh = rtfact::readPly(f, header);
+        const auto mesh = rtfact::surfaces::readPly(f, header);
         (void)mesh;
     } catch (const rtfact::Error&) {
     }

@@ -4,7 +4,7 @@
 
 #include "core/util/error.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 AABB Mesh::bounds() const {
     AABB b;
@@ -85,4 +85,4 @@ void Mesh::append(const Mesh& o) {
     normalsComputed = normalsComputed || rhs.normalsComputed;
 }
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

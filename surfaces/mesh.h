@@ -7,7 +7,7 @@
 
 #include "core/math/aabb.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 // A material as described by an OBJ/MTL file (or defaults for other formats).
 struct MeshMaterial {
@@ -43,4 +43,4 @@ struct Mesh {
     void append(const Mesh& other);
 };
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -35,7 +35,7 @@
 #include "surfaces/ply_reader.h"
 #include "surfaces/vtk_legacy_check.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 namespace fs = std::filesystem;
 
 namespace {
@@ -506,4 +506,4 @@ Mesh loadMeshes(const std::vector<std::string>& files) {
     return all;
 }
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -8,7 +8,7 @@
 
 #include "surfaces/mesh.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 // What kind of mesh file a path holds, judged from its extension and header, without
 // loading it. NotMesh covers point clouds (PLY without faces) and volume datasets.
@@ -21,4 +21,4 @@ Mesh loadMesh(const std::string& file);
 // Several files merged into one mesh (materials kept per file).
 Mesh loadMeshes(const std::vector<std::string>& files);
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

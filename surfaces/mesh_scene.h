@@ -25,7 +25,7 @@
 #include "surfaces/textures.h"
 #include "surfaces/triangle.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 // The triangles of a mesh in index order (triangle i = indices[3i..3i+2]).
 inline std::vector<Triangle> meshTriangles(const Mesh& m) {
@@ -233,4 +233,4 @@ static_assert(IncoherentQueries<MeshScene<BVH<Triangle>>, 1> &&
               IncoherentQueries<MeshScene<BVH<Triangle>>, 64>);
 static_assert(Intersector<WideBVHIntersector<TriangleIntersector>, WideBVH<Triangle, kMeshWideArity>>);
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -4,6 +4,6 @@
 #include "core/render/path_integrator.h"
 #include "surfaces/mesh.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 static_assert(MtlStyleMaterial<MeshMaterial>);
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

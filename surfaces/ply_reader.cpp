@@ -9,7 +9,7 @@
 
 #include "core/util/error.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 namespace {
 
@@ -268,4 +268,4 @@ uint64_t plyTriangleEstimate(const io::PlyHeader& h) {
     return faces + strips;
 }
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -10,7 +10,7 @@
 #include "core/io/ply_header.h"
 #include "surfaces/mesh.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 // Reads the body of `f`, whose header is `h` (from io::readPlyHeader(f)).
 Mesh readPly(const io::MappedFile& f, const io::PlyHeader& h);
@@ -30,4 +30,4 @@ bool plyHasFaces(const io::PlyHeader& h);
 // reading uses the real count.
 uint64_t plyTriangleEstimate(const io::PlyHeader& h);
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

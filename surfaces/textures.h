@@ -8,7 +8,7 @@
 #include "core/concepts/texture.h"
 #include "core/render/image_io.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 struct ConstantTexture {
     Vec3f value{1.0f};
@@ -62,4 +62,4 @@ struct ImageTexture {
 };
 static_assert(Texture<ImageTexture>);
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -16,7 +16,7 @@
 #include "core/concepts/intersector_hooks.h"
 #include "core/simd/bitmask.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 // Compact layout: the three vertices (36 bytes); the normal is recomputed per test
 // (a handful of scalar operations, cheaper than the extra memory traffic).
@@ -142,4 +142,4 @@ static_assert(ElementIntersector<TriangleIntersector, Triangle>);
 // The wide BVH tests whole leaves through this hook (else one triangle at a time).
 static_assert(LeafIntersector<TriangleIntersector, Triangle>);
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -15,18 +15,15 @@
 #include <limits>
 #include <vector>
 
+#include "core/io/file_helpers.h"
 #include "core/util/error.h"
 
-namespace rtfact {
+namespace rtfact::surfaces {
 namespace {
 
 constexpr uint64_t kMaxCount = uint64_t(std::numeric_limits<int64_t>::max());
 constexpr size_t kMaxToken = 255;  // VTK reads keywords into char[256]
 
-std::string lower(std::string s) {
-    for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
 std::string upper(std::string s) {
     for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
     return s;
@@ -161,7 +158,7 @@ VtkLegacyHeader parseHeader(Source& s) {
     if (!s.line(l, 0)) s.fail("truncated VTK header: the file ends in the title line");
     std::string t;
     if (!s.token(t)) s.fail("truncated VTK header: no ASCII or BINARY line");
-    const std::string fmt = lower(t);
+    const std::string fmt = io::lower(t);
     if (fmt == "binary")
         h.binary = true;
     else if (fmt != "ascii")
@@ -238,7 +235,7 @@ class Walker {
 
     ValueType type(const std::string& what) {
         const std::string t = word(what + " data type");
-        const std::string n = lower(t);
+        const std::string n = io::lower(t);
         ValueType v;
         v.name = n;
         if (n == "char" || n == "signed_char")
@@ -577,4 +574,4 @@ VtkLegacySummary validateVtkLegacyPolyData(const std::string& file) {
     return Walker(s, h).run();
 }
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-namespace rtfact {
+namespace rtfact::surfaces {
 
 struct VtkLegacyHeader {
     bool vtk = false;          // the first line starts with "# vtk DataFile Version"
@@ -32,4 +32,4 @@ VtkLegacyHeader readVtkLegacyHeader(const std::string& file);
 // point indices, attribute counts, unknown sections, unsupported types).
 VtkLegacySummary validateVtkLegacyPolyData(const std::string& file);
 
-}  // namespace rtfact
+}  // namespace rtfact::surfaces

@@ -19,7 +19,7 @@ engine::LightSpec parseLight(const std::string& s) {
 }
 
 // --material lambert[:r,g,b] | mirror[:r,g,b] | glass[:ior] replaces every material.
-MeshMaterial parseMaterial(const std::string& spec) {
+surfaces::MeshMaterial parseMaterial(const std::string& spec) {
     const size_t c = spec.find(':');
     const std::string kind = spec.substr(0, c), arg = c == std::string::npos ? "" : spec.substr(c + 1);
     auto colour = [&]() -> std::optional<Vec3f> {

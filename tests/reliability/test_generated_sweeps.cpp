@@ -25,6 +25,7 @@
 #include "volume/volume_io.h"
 
 using namespace rtfact;
+using namespace rtfact::surfaces;
 using namespace rtfact::reliability;
 
 namespace {

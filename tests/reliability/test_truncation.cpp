@@ -18,6 +18,7 @@
 
 namespace fs = std::filesystem;
 using namespace rtfact;
+using namespace rtfact::surfaces;
 using namespace rtfact::reliability;
 
 TEST(Hostile, MeshPlyTruncatedAndFlipped) {

@@ -20,6 +20,7 @@
 #include "tests/common/image_compare.h"
 
 using namespace rtfact;
+using namespace rtfact::surfaces;
 
 namespace {
 

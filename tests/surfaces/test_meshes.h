@@ -8,6 +8,8 @@
 
 namespace rtfact::test {
 
+using namespace rtfact::surfaces;
+
 // A jittered height field over [-1,1]^2 (y up): closed under shared edges, every ray
 // crossing it from above hits it.
 inline Mesh heightField(int n, uint32_t seed = 1) {

@@ -15,6 +15,7 @@
 #include "tests/common/image_compare.h"
 
 using namespace rtfact;
+using namespace rtfact::surfaces;
 
 namespace {
 

@@ -24,6 +24,7 @@
 #include "tests/common/image_compare.h"
 
 using namespace rtfact;
+using namespace rtfact::surfaces;
 namespace fs = std::filesystem;
 
 namespace {

@@ -12,6 +12,7 @@
 #include "tests/common/image_compare.h"
 
 using namespace rtfact;
+using namespace rtfact::surfaces;
 
 TEST(Textures, CheckerAlternates) {
     const CheckerTexture c{Vec3f(1.0f), Vec3f(0.0f), 2.0f};

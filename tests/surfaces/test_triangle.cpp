@@ -9,6 +9,7 @@
 #include "test_meshes.h"
 
 using namespace rtfact;
+using namespace rtfact::surfaces;
 
 namespace {
 

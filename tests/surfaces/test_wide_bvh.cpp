@@ -21,6 +21,7 @@
 #include "test_meshes.h"
 
 using namespace rtfact;
+using namespace rtfact::surfaces;
 
 namespace {
 
