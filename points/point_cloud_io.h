@@ -31,12 +31,4 @@ std::optional<PointFileInfo> probePointFile(const std::string& file);
 // Writes a binary little-endian PLY with x y z [nx ny nz] [red green blue] [radius].
 void writePly(const std::string& file, const PointCloud& cloud);
 
-// A triangle mesh read from a PLY file (vertices and triangles only): input of the
-// point generator. Polygons are fanned into triangles.
-struct TriangleMesh {
-    std::vector<Vec3f> vertices;
-    std::vector<std::array<uint32_t, 3>> triangles;
-};
-TriangleMesh loadPlyMesh(const std::string& file);
-
 }  // namespace rtfact::points

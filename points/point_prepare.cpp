@@ -17,9 +17,9 @@
 #include <thread>
 
 #include "core/util/error.h"
+#include "core/util/huge_pages.h"
 #include "core/util/memory_budget.h"
 #include "core/util/progress.h"
-#include "core/util/huge_pages.h"
 
 namespace rtfact::points {
 

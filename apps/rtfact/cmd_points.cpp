@@ -6,6 +6,7 @@
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/point_options.h"
 #include "apps/rtfact/render_command.h"
+#include "engine/built_scene.h"
 #include "engine/render_session.h"
 #include "engine/stats.h"
 #include "points/point_cloud_io.h"
@@ -51,8 +52,8 @@ void addGenPointsCommand(CLI::App& gen, CommandList& list) {
     };
     auto o = std::make_shared<Opts>();
     CLI::App* cmd =
-        gen.add_subcommand("points", "Sample a triangle mesh (PLY) into a point cloud PLY with normals and radii");
-    cmd->add_option("--from", o->from, "Input mesh (.ply with faces)")->required();
+        gen.add_subcommand("points", "Sample a triangle mesh into a point cloud PLY with normals and radii");
+    cmd->add_option("--from", o->from, "Input mesh (.ply .obj .stl .vtk .vtp)")->required();
     cmd->add_option("--count", o->count, "Number of points")
         ->capture_default_str()
         ->check(CLI::Range(1ull, 500000000ull));
@@ -62,16 +63,26 @@ void addGenPointsCommand(CLI::App& gen, CommandList& list) {
         ->capture_default_str()
         ->check(finiteRange(0.1, 100.0));
     cmd->add_flag("--quiet", o->quiet, "No messages");
-    list.push_back({cmd, [o] {
-                        const auto t0 = std::chrono::steady_clock::now();
-                        const TriangleMesh mesh = loadPlyMesh(o->from);
-                        PointCloud pc = samplePointsOnMesh(mesh, size_t(o->count), o->seed, o->radiusFactor);
-                        writePly(o->out, pc);
-                        if (!o->quiet)
-                            std::printf("wrote %s: %zu points from %zu triangles in %.0f ms\n", o->out.c_str(),
-                                        pc.size(), mesh.triangles.size(), engine::msSince(t0));
-                        return 0;
-                    }});
+    list.push_back(
+        {cmd, [o] {
+             const auto t0 = std::chrono::steady_clock::now();
+             // Any mesh the engine opens (PLY, OBJ, STL, VTK, VTP), through the one reader per format.
+             engine::OpenOptions oo;
+             oo.kind = engine::SceneKind::Mesh;
+             oo.progress = !o->quiet;
+             const auto loaded = engine::loadedMesh(engine::open({o->from}, oo));
+             TriangleMesh mesh;
+             mesh.vertices = loaded->positions;
+             mesh.triangles.resize(loaded->triangles());
+             for (size_t t = 0; t < mesh.triangles.size(); ++t)
+                 mesh.triangles[t] = {loaded->indices[3 * t], loaded->indices[3 * t + 1], loaded->indices[3 * t + 2]};
+             PointCloud pc = samplePointsOnMesh(mesh, size_t(o->count), o->seed, o->radiusFactor);
+             writePly(o->out, pc);
+             if (!o->quiet)
+                 std::printf("wrote %s: %zu points from %zu triangles in %.0f ms\n", o->out.c_str(), pc.size(),
+                             mesh.triangles.size(), engine::msSince(t0));
+             return 0;
+         }});
 }
 
 }  // namespace rtfact::app

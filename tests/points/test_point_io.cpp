@@ -215,8 +215,6 @@ TEST(PlyProbe, MeshesAreNotPointClouds) {
         "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     const std::string f = writeFile("mesh.ply", mesh);
     EXPECT_FALSE(probePointFile(f).has_value());
-    const TriangleMesh m = loadPlyMesh(f);
-    EXPECT_EQ(m.triangles.size(), 1u);
     const auto info = probePointFile(writeFile("cloud.ply", binaryPly(false)));
     ASSERT_TRUE(info.has_value());
     EXPECT_EQ(info->points, 3u);
