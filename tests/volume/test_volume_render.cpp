@@ -21,10 +21,6 @@
 using namespace rtfact;
 using namespace rtfact::volume;
 
-static_assert(Integrator<VolumeIntegrator, VolumeScene<uint8_t>>);
-static_assert(Integrator<VolumeIntegrator, VolumeScene<uint16_t>>);
-static_assert(Integrator<VolumeIntegrator, VolumeScene<float>>);
-
 namespace {
 
 constexpr int kW = simd::kNativeWidth;
