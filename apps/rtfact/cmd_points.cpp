@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "apps/rtfact/commands.h"
+#include "apps/rtfact/point_options.h"
 #include "apps/rtfact/render_command.h"
 #include "engine/render_session.h"
 #include "engine/stats.h"
@@ -18,55 +19,18 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
     struct Opts {
         CommonOptions common;
         std::string file;
-        engine::PointSettings settings;
-        std::string lod = "on";
-        std::string color = "rgb";
+        PointOptions points;
     };
     auto o = std::make_shared<Opts>();
-    engine::PointSettings& ps = o->settings;
     CLI::App* cmd =
         app.add_subcommand("points", "Render a point cloud (PLY, PCD, XYZ/PTS) as discs with a LoD kd-tree");
     o->common.packet = engine::defaultPacketSize(engine::SceneKind::Points);
     o->common.addTo(*cmd, "points.png");
     cmd->add_option("FILE", o->file, "Point cloud file (.ply .pcd .xyz .pts)")->required();
-    auto* r =
-        cmd->add_option("--radius", ps.radius, "Disc radius for every point (world units)")->check(positiveFinite());
-    cmd->add_option("--radius-factor", ps.radiusFactor, "Scale of the radii (file radii or neighbour spacing)")
-        ->capture_default_str()
-        ->check(finiteRange(1e-3, 1e3))
-        ->excludes(r);
-    cmd->add_option("--normals", ps.normals, "auto|estimate|file")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"auto", "estimate", "file"}));
-    cmd->add_option("--lod-quality", ps.lodQuality,
-                    "Node answered by its representative disc when its size < footprint x Q (0: full detail)")
-        ->capture_default_str()
-        ->check(finiteRange(0.0, 64.0));
-    cmd->add_option("--lod", o->lod, "on|off (off = full detail)")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"on", "off"}));
-    cmd->add_option("--color", o->color, "rgb|intensity|lod|normal")
-        ->capture_default_str()
-        ->check(CLI::IsMember({"rgb", "intensity", "lod", "normal"}));
-    cmd->add_option("--integrator", ps.integrator, joined(engine::pointIntegrators()))
-        ->capture_default_str()
-        ->check(CLI::IsMember(engine::pointIntegrators()));
-    cmd->add_option("--ao-samples", ps.aoSamples, "AO rays per sample")
-        ->capture_default_str()
-        ->check(CLI::Range(1, 256));
-    cmd->add_option("--leaf-size", ps.leafSize, "Maximum points per kd-tree leaf")
-        ->capture_default_str()
-        ->check(CLI::Range(1, 64));
+    o->points.addTo(*cmd);
     list.push_back({cmd, [o] {
                         return runRenderCommand(
-                            o->common,
-                            [&] {
-                                engine::Settings s;
-                                s.points = o->settings;
-                                s.points.lod = o->lod == "on";
-                                s.points.color = parseColorMode(o->color);
-                                return s;
-                            },
+                            o->common, [&] { return o->points.toSettings(); },
                             [&] {
                                 engine::OpenOptions oo;
                                 oo.kind = engine::SceneKind::Points;
