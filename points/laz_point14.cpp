@@ -244,7 +244,7 @@ class Point14Decoder {
                 break;
             case 3:
                 if (gpsChange)
-                    r = xy.decodeSymbol(c->returnNumber[n]);
+                    r = xy.decodeSymbol(c->returnNumber[r]);
                 else
                     r = (r + xy.decodeSymbol(c->returnNumberGpsSame) + 2) & 15;
                 break;
