@@ -29,7 +29,7 @@ struct BitModel {
     uint32_t bit0Prob = 1u << (kBitLengthShift - 1), bit0Count = 1, bitCount = 2;
     uint32_t updateCycle = 4, bitsUntilUpdate = 4;
 
-    void update() {
+    [[gnu::noinline]] void update() {
         if ((bitCount += updateCycle) > kBitMaxCount) {
             bitCount = (bitCount + 1) >> 1;
             bit0Count = (bit0Count + 1) >> 1;
@@ -65,7 +65,7 @@ class SymbolModel {
         symbolsUntilUpdate_ = updateCycle_ = (symbols + 6) >> 1;
     }
 
-    void update() {
+    [[gnu::noinline]] void update() {
         if ((totalCount_ += updateCycle_) > kSymMaxCount) {
             totalCount_ = 0;
             for (uint32_t k = 0; k < symbols_; ++k) totalCount_ += (counts_[k] = (counts_[k] + 1) >> 1);
@@ -125,7 +125,7 @@ class ArithmeticDecoder {
     uint32_t overrun() const { return overrun_; }
     const uint8_t* position() const { return p_; }
 
-    uint32_t decodeBit(BitModel& m) {
+    [[gnu::always_inline]] uint32_t decodeBit(BitModel& m) {
         const uint32_t x = m.bit0Prob * (length_ >> kBitLengthShift);
         uint32_t sym;
         if (value_ < x) {
@@ -142,7 +142,7 @@ class ArithmeticDecoder {
         return sym;
     }
 
-    uint32_t decodeSymbol(SymbolModel& m) {
+    [[gnu::always_inline]] uint32_t decodeSymbol(SymbolModel& m) {
         uint32_t sym, x, y = length_;
         if (m.table_) {
             length_ >>= kSymLengthShift;
