@@ -1,4 +1,4 @@
-// Compressor 3 items, version 3 (POINT14, RGB14, RGBNIR14, BYTE14). The XY layer carries,
+// Compressor 3 items, version 3 (POINT14, RGB14, RGBNIR14, WAVEPACKET14, BYTE14). The XY layer carries,
 // per point, which of scanner channel, point source, GPS time, scan angle, number of
 // returns and return number changed; the other layers decode only what changed, each with
 // predictions from the previous point of the same scanner channel.
@@ -420,6 +420,74 @@ class Byte14Decoder {
     std::unique_ptr<Context> contexts_[4];
 };
 
+// Wave packet (descriptor index, byte offset, packet size, return point location and the
+// x(t), y(t), z(t) parameters, floats coded as their 32-bit patterns), per scanner channel.
+class WavePacket14Decoder {
+   public:
+    Layer layer;
+
+    void init(const uint8_t* raw, uint32_t context) {
+        current_ = context;
+        contexts_[current_] = std::make_unique<Context>(raw);
+    }
+    void read(uint8_t* out, uint32_t context) {
+        if (context != current_) {
+            if (!contexts_[context]) contexts_[context] = std::make_unique<Context>(contexts_[current_]->last);
+            current_ = context;
+        }
+        Context& c = *contexts_[current_];
+        if (layer.present) {
+            ArithmeticDecoder& dec = layer.dec;
+            uint8_t v[29];
+            v[0] = uint8_t(dec.decodeSymbol(c.packetIndex));
+            const uint64_t lastOffset = loadU64(c.last + 1);
+            const uint32_t lastSize = loadU32(c.last + 9);
+            c.lastOffsetSym = dec.decodeSymbol(c.offsetDiff[c.lastOffsetSym]);
+            uint64_t offset;
+            switch (c.lastOffsetSym) {
+                case 0:
+                    offset = lastOffset;
+                    break;
+                case 1:
+                    offset = lastOffset + lastSize;
+                    break;
+                case 2:
+                    c.lastDiff32 = c.icOffsetDiff.decompress(dec, c.lastDiff32);
+                    offset = lastOffset + uint64_t(int64_t(c.lastDiff32));
+                    break;
+                default: {
+                    const uint64_t lower = dec.readInt();
+                    offset = (uint64_t(dec.readInt()) << 32) | lower;
+                }
+            }
+            std::memcpy(v + 1, &offset, 8);
+            const int32_t size = c.icPacketSize.decompress(dec, int32_t(lastSize));
+            std::memcpy(v + 9, &size, 4);
+            const int32_t location = c.icReturnPoint.decompress(dec, int32_t(loadU32(c.last + 13)));
+            std::memcpy(v + 13, &location, 4);
+            for (uint32_t a = 0; a < 3; ++a) {
+                const int32_t x = c.icXyz.decompress(dec, int32_t(loadU32(c.last + 17 + 4 * a)), a);
+                std::memcpy(v + 17 + 4 * a, &x, 4);
+            }
+            std::memcpy(c.last, v, 29);
+        }
+        std::memcpy(out, c.last, 29);
+    }
+
+   private:
+    struct Context {
+        uint8_t last[29];
+        int32_t lastDiff32 = 0;
+        uint32_t lastOffsetSym = 0;
+        SymbolModel packetIndex{256};
+        SymbolModel offsetDiff[4] = {SymbolModel(4), SymbolModel(4), SymbolModel(4), SymbolModel(4)};
+        IntegerDecompressor icOffsetDiff{32}, icPacketSize{32}, icReturnPoint{32}, icXyz{32, 3};
+        explicit Context(const uint8_t* from) { std::memcpy(last, from, 29); }
+    };
+    uint32_t current_ = 0;
+    std::unique_ptr<Context> contexts_[4];
+};
+
 }  // namespace
 
 void decodeLayeredChunk(const LazInfo& info, std::span<const uint8_t> bytes, uint64_t points, uint8_t* out,
@@ -441,7 +509,8 @@ void decodeLayeredChunk(const LazInfo& info, std::span<const uint8_t> bytes, uin
     Point14Decoder point;
     std::unique_ptr<RgbNir14Decoder> rgb;
     std::unique_ptr<Byte14Decoder> extra;
-    uint32_t rgbAt = 0, extraAt = 0, offset = 0;
+    std::unique_ptr<WavePacket14Decoder> wave;
+    uint32_t rgbAt = 0, extraAt = 0, waveAt = 0, offset = 0;
     std::vector<Layer*> layers;  // in the order of their sizes and bytes
     for (const Item& it : info.items) {
         switch (it.type) {
@@ -454,6 +523,11 @@ void decodeLayeredChunk(const LazInfo& info, std::span<const uint8_t> bytes, uin
                 rgbAt = offset;
                 layers.push_back(&rgb->rgb);
                 if (it.type == kRgbNir14) layers.push_back(&rgb->nir);
+                break;
+            case kWavePacket14:
+                wave = std::make_unique<WavePacket14Decoder>();
+                waveAt = offset;
+                layers.push_back(&wave->layer);
                 break;
             case kByte14:
                 extra = std::make_unique<Byte14Decoder>(it.size);
@@ -484,11 +558,13 @@ void decodeLayeredChunk(const LazInfo& info, std::span<const uint8_t> bytes, uin
     uint32_t context = 0;
     point.init(out, context);
     if (rgb) rgb->init(out + rgbAt, context);
+    if (wave) wave->init(out + waveAt, context);
     if (extra) extra->init(out + extraAt, context);
     uint8_t* rec = out + recordLength;
     for (uint64_t i = 1; i < points; ++i, rec += recordLength) {
         point.read(rec, context);
         if (rgb) rgb->read(rec + rgbAt, context);
+        if (wave) wave->read(rec + waveAt, context);
         if (extra) extra->read(rec + extraAt, context);
         if (point.layers[kXY].dec.overrun() > 8) [[unlikely]]
             fail("truncated or corrupt (its XY layer ends at point " + std::to_string(i) + " of " +

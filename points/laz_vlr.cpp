@@ -110,6 +110,9 @@ void checkItems(const LazInfo& info, const std::string& source) {
             case kRgbNir14:
                 size = 8;
                 break;
+            case kWavePacket14:
+                size = 29;
+                break;
             case kByte:
             case kByte14:
                 size = it.size;
@@ -120,7 +123,7 @@ void checkItems(const LazInfo& info, const std::string& source) {
         const bool layeredItem = it.type >= kPoint14;
         if (layeredItem != layered)
             fail(what + " item with compressor " + std::to_string(info.compressor) +
-                 (layered ? " (layered: only POINT14, RGB14, RGBNIR14, BYTE14)"
+                 (layered ? " (layered: only POINT14, RGB14, RGBNIR14, WAVEPACKET14, BYTE14)"
                           : " (point-wise: only POINT10, GPSTIME11, RGB12, BYTE)"));
         if (it.version != version)
             fail(what + " is not supported (version " + std::to_string(version) + " is, with compressor " +
@@ -128,6 +131,16 @@ void checkItems(const LazInfo& info, const std::string& source) {
         if (size == 0 || it.size != size)
             fail(what + " item has size " + std::to_string(it.size) + " (expected " +
                  (size ? std::to_string(size) : std::string("at least 1")) + ")");
+        // Point-wise items share one stream: decoded in the order POINT10, GPSTIME11, RGB12,
+        // BYTE. Layered items have a stream each, but at most one of every kind.
+        for (size_t j = 0; j < i; ++j) {
+            const uint16_t prev = info.items[j].type;
+            const bool rgbTwice = (prev == kRgb14 || prev == kRgbNir14) && (it.type == kRgb14 || it.type == kRgbNir14);
+            if ((prev == it.type && it.type != kByte) || rgbTwice) fail("a second " + what + " item");
+            auto rank = [](uint16_t t) { return t == kByte ? 3 : t == kRgb12 ? 2 : t == kGpsTime11 ? 1 : 0; };
+            if (!layered && rank(prev) > rank(it.type))
+                fail(what + " item after " + itemName(prev) + " (point-wise order: POINT10, GPSTIME11, RGB12, BYTE)");
+        }
         if ((i == 0) != (it.type == kPoint10 || it.type == kPoint14))
             fail(i == 0 ? what + " as first item (the core point, POINT10 or POINT14, must come first)"
                         : "a second core point item (" + what + ")");

@@ -93,6 +93,20 @@ void expectInsideBounds(const Decoded& d, bool attained = false) {
         }
 }
 
+// Points by return number as the header counts them (when its counts add up).
+void expectReturnCounts(const Decoded& d) {
+    uint64_t sum = 0;
+    for (uint64_t c : d.header.pointsByReturn) sum += c;
+    if (sum != d.header.pointCount) return;
+    std::array<uint64_t, 16> counts{};
+    const uint32_t len = d.info.recordLength();
+    for (uint64_t i = 0; i < d.header.pointCount; ++i) {
+        const uint8_t b = d.records[i * len + 14];
+        ++counts[d.header.pointFormat >= 6 ? b & 15 : b & 7];
+    }
+    for (int r = 1; r <= 15; ++r) EXPECT_EQ(counts[r], d.header.pointsByReturn[r - 1]) << "return " << r;
+}
+
 std::string errorOf(const std::vector<uint8_t>& file) {
     try {
         decodeBytes(bytes(file), "hostile.laz");
@@ -198,12 +212,38 @@ TEST(LazDecoder, CopcVariableChunksHoldTheSamePoints) {
 TEST(LazDecoder, OtherFilesDecodeInsideTheirBounds) {
     REQUIRE_SHARED("Megaplot.laz");
     for (const char* name : {"Megaplot.laz", "Topography.laz", "lone-star.copc.laz", "extra.laz",
-                             "las_with_several_extra_byte_bloc.laz"}) {
+                             "las_with_several_extra_byte_bloc.laz", "autzen_trim.laz"}) {
         SCOPED_TRACE(name);
         const Decoded d = decodeFile(shared(name));
         EXPECT_GT(d.header.pointCount, 0u);
         expectInsideBounds(d, true);
+        expectReturnCounts(d);
     }
+}
+
+// Full waveform (PDRF 10: POINT14, RGBNIR14, WAVEPACKET14): every point refers to
+// descriptor 1 with 4,968-byte packets; returns of one pulse share a waveform, so the
+// 10,750 points have 7,124 distinct offsets (one per first return), in order.
+TEST(LazDecoder, WavePacketsDecode) {
+    REQUIRE_SHARED("fullwave.laz");
+    const Decoded d = decodeFile(shared("fullwave.laz"));
+    ASSERT_EQ(d.header.pointCount, 10750u);
+    ASSERT_EQ(d.info.recordLength(), 67u);
+    expectInsideBounds(d, true);
+    expectReturnCounts(d);
+    std::vector<uint64_t> offsets;
+    for (uint64_t i = 0; i < d.header.pointCount; ++i) {
+        const uint8_t* w = d.records.data() + i * 67 + 38;
+        ASSERT_EQ(w[0], 1) << "point " << i;
+        uint32_t size;
+        std::memcpy(&size, w + 9, 4);
+        ASSERT_EQ(size, 4968u) << "point " << i;
+        uint64_t offset;
+        std::memcpy(&offset, w + 1, 8);
+        offsets.push_back(offset);
+    }
+    std::sort(offsets.begin(), offsets.end());
+    EXPECT_EQ(std::unique(offsets.begin(), offsets.end()) - offsets.begin(), 7124);
 }
 
 // Hostile files, made from the shipped simple.laz: a chunk table pointer, the table, the
@@ -260,6 +300,11 @@ TEST(LazDecoder, HostileFilesGiveOneLineErrors) {
         const uint16_t bad = 77;
         std::memcpy(f.data() + vlr->offset + 34 + 6, &bad, 2);
         expectError(f, "unknown item type 77");
+    }
+    {  // point-wise items out of their decoding order (RGB12 before GPSTIME11)
+        auto f = good;
+        std::swap_ranges(f.begin() + vlr->offset + 40, f.begin() + vlr->offset + 46, f.begin() + vlr->offset + 46);
+        expectError(f, "GPSTIME11 v2 item after RGB12");
     }
     {  // unknown compressor
         auto f = good;
