@@ -35,11 +35,13 @@ std::vector<Chunk> readChunkTable(const LazInfo& info, std::span<const uint8_t> 
             fail(std::to_string(count) + " chunks for " + std::to_string(pointCount) + " points in chunks of " +
                  std::to_string(info.chunkSize) + " (expected " + std::to_string(expected) + ")");
     }
-    // Each entry takes at least a few bits: a count far beyond the table's bytes is a lie
-    // (checked before allocating).
+    // Every chunk starts with a raw point: a count that cannot fit between the point data
+    // and the table is a lie (checked before allocating).
     const uint64_t tableBytes = size - uint64_t(tableOffset) - 8;
-    if (count > 64 * (tableBytes + 1))
-        fail(std::to_string(count) + " chunks do not fit in its " + std::to_string(tableBytes) + " bytes");
+    const uint64_t recordLength = info.recordLength();
+    if (recordLength == 0 || count > (uint64_t(tableOffset) - firstChunk) / recordLength)
+        fail(std::to_string(count) + " chunks do not fit in " + std::to_string(uint64_t(tableOffset) - firstChunk) +
+             " bytes of point data");
     std::vector<Chunk> chunks(count);
     if (count == 0) {
         if (pointCount) fail("no chunks for " + std::to_string(pointCount) + " points");
@@ -65,6 +67,9 @@ std::vector<Chunk> readChunkTable(const LazInfo& info, std::span<const uint8_t> 
             fail("chunk " + std::to_string(i) + " (" + std::to_string(c.bytes) + " bytes at " + std::to_string(offset) +
                  ") runs past the table at " + std::to_string(tableOffset));
         if (c.points == 0 && pointCount) fail("chunk " + std::to_string(i) + " has no points");
+        if (c.bytes < recordLength)
+            fail("chunk " + std::to_string(i) + " has " + std::to_string(c.bytes) +
+                 " bytes, less than its first (raw) point");
         offset += c.bytes;
         point += c.points;
         if (point > pointCount) fail("chunks hold more than the header's " + std::to_string(pointCount) + " points");
