@@ -64,6 +64,11 @@ class SymbolModel {
         update();
         symbolsUntilUpdate_ = updateCycle_ = (symbols + 6) >> 1;
     }
+    // Movable (the pointers follow the moved buffer), never copied (they would not).
+    SymbolModel(SymbolModel&&) noexcept = default;
+    SymbolModel& operator=(SymbolModel&&) noexcept = default;
+    SymbolModel(const SymbolModel&) = delete;
+    SymbolModel& operator=(const SymbolModel&) = delete;
 
     [[gnu::noinline]] void update() {
         if ((totalCount_ += updateCycle_) > kSymMaxCount) {
@@ -236,6 +241,8 @@ class IntegerDecompressor {
             corrRange_ = 0;
             corrMin_ = INT32_MIN;
         }
+        kModels_.reserve(contexts);
+        correctors_.reserve(bits);
         for (uint32_t i = 0; i < contexts; ++i) kModels_.emplace_back(bits + 1);
         for (uint32_t i = 1; i <= bits; ++i) correctors_.emplace_back(i <= bitsHigh ? 1u << i : 1u << bitsHigh);
     }
