@@ -164,8 +164,9 @@ def main():
         d = rng.normal(size=(a.points, 3))
         xyz = (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)
         ply = f"{tmp}/sphere.ply"
-        # Unit-sphere points with their normals (= positions), so that neither side spends
-        # the time on normal estimation.
+        radius = 2.0 / np.sqrt(a.points)  # about the spacing of N points on the unit sphere
+        # Unit-sphere points with their normals (= positions) and one radius, so that neither
+        # side spends the time on normal or spacing estimation.
         rec = np.zeros(a.points, dtype=[(c, "<f4") for c in ("x", "y", "z", "nx", "ny", "nz")])
         rec["x"], rec["y"], rec["z"] = xyz.T
         rec["nx"], rec["ny"], rec["nz"] = xyz.T
@@ -175,11 +176,12 @@ def main():
             fh.write(rec.tobytes())
 
         def cli_arr():
-            return cli_run(a.cli, ["points", ply, "-o", f"{tmp}/c.png", "--size", a.size, "--spp", str(a.spp)])
+            return cli_run(a.cli, ["points", ply, "-o", f"{tmp}/c.png", "--size", a.size, "--spp", str(a.spp),
+                                   "--radius", str(radius)])
 
         def py_arr():
             t0 = time.perf_counter()
-            img, st = rtfact.render(rtfact.points(xyz, normals=xyz), size=(w, h), spp=a.spp, stats=True)
+            img, st = rtfact.render(rtfact.points(xyz, normals=xyz), size=(w, h), spp=a.spp, radius=radius, stats=True)
             t1 = time.perf_counter()
             rtfact.save_image(f"{tmp}/p.png", img)
             t2 = time.perf_counter()

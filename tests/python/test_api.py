@@ -21,6 +21,8 @@ def test_load_and_info_of_each_kind():
     assert i["bounds"] == p.bounds and len(i["bounds"]) == 2
     m = rtfact.load(BUNNY_MESH)
     assert m.kind == "mesh" and m.info()["triangles"] > 1000
+    merged = rtfact.load([BUNNY_MESH, BUNNY_MESH])  # several mesh files: one scene
+    assert merged.info()["triangles"] == 2 * m.info()["triangles"]
     v = rtfact.load(TOOTH)
     vi = v.info()
     assert v.kind == "volume" and vi["dims"] == (103, 94, 161) and vi["voxels"] == 103 * 94 * 161
