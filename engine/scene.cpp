@@ -1,5 +1,7 @@
 #include "engine/scene.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -272,6 +274,139 @@ Scene spheres(int count) {
     d->info.add("kind", "spheres");
     d->info.add("spheres", (unsigned long long)s.spheres.size());
     d->info.add("bounds", boundsText(d->bounds));
+    return Scene{d};
+}
+
+Scene pointsFromCloud(points::PointCloud cloud, const std::string& source) {
+    const size_t n = cloud.positions.size();
+    if (n == 0) throw UsageError(source, "no points");
+    auto sized = [&](size_t m, const char* what) {
+        if (m != 0 && m != n)
+            throw UsageError(source, std::string(what) + " has " + std::to_string(m) + " entries for " +
+                                         std::to_string(n) + " points");
+    };
+    sized(cloud.colors.size(), "colors");
+    sized(cloud.normals.size(), "normals");
+    sized(cloud.radii.size(), "radius");
+    sized(cloud.intensities.size(), "intensity");
+    auto finite3 = [](const Vec3f& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); };
+    for (size_t i = 0; i < n; ++i)
+        if (!finite3(cloud.positions[i]))
+            throw UsageError(source, "non-finite coordinate at point " + std::to_string(i));
+    for (size_t i = 0; i < cloud.normals.size(); ++i)
+        if (!finite3(cloud.normals[i])) throw UsageError(source, "non-finite normal at point " + std::to_string(i));
+    for (size_t i = 0; i < cloud.radii.size(); ++i)
+        if (!(std::isfinite(cloud.radii[i]) && cloud.radii[i] > 0))
+            throw UsageError(source, "radius at point " + std::to_string(i) + " is not a positive finite number");
+    for (size_t i = 0; i < cloud.intensities.size(); ++i)
+        if (!std::isfinite(cloud.intensities[i]))
+            throw UsageError(source, "non-finite intensity at point " + std::to_string(i));
+    auto d = makeData(SceneKind::Points, "");
+    d->points.cloud = std::move(cloud);
+    d->points.cloud.format = "memory";
+    finishPoints(*d);
+    return Scene{d};
+}
+
+namespace {
+
+// Stored value of a view's voxel: i16 shifted into u16 (offset -32768, as the loaders).
+template <class T>
+float viewStored(const uint8_t* p) {
+    T v;
+    std::memcpy(&v, p, sizeof v);
+    if constexpr (std::is_same_v<T, int16_t>)
+        return float(int(v) + 32768);
+    else
+        return float(v);
+}
+
+template <class T>
+void brickView(const VolumeView& view, volume::BrickedVolume& v, const std::string& source) {
+    using BV = volume::BrickedVolume;
+    const auto* base = static_cast<const uint8_t*>(view.data);
+    const auto& dims = view.dims;
+    auto at = [&](int x, int y, int z) {
+        x = std::min(x, dims[0] - 1);
+        y = std::min(y, dims[1] - 1);
+        z = std::min(z, dims[2] - 1);
+        return viewStored<T>(base + int64_t(x) * view.strides[0] + int64_t(y) * view.strides[1] +
+                             int64_t(z) * view.strides[2]);
+    };
+    if constexpr (std::is_same_v<T, float>) {
+        for (int z = 0; z < dims[2]; ++z)
+            for (int y = 0; y < dims[1]; ++y)
+                for (int x = 0; x < dims[0]; ++x)
+                    if (!std::isfinite(at(x, y, z)))
+                        throw UsageError(source, fmt("non-finite value at voxel (x=%d, y=%d, z=%d)", x, y, z));
+    }
+    // All-zero bricks share brick 0 (as brickVolume does); the others are filled in order
+    // into a pool reserved once, so no dense copy and no pool regrowth.
+    const size_t nb = v.brickCount();
+    std::vector<uint8_t> zero(nb, 0);
+    tbb::parallel_for(size_t(0), nb, [&](size_t b) {
+        const int bx = int(b % size_t(v.nb[0])), by = int((b / size_t(v.nb[0])) % size_t(v.nb[1])),
+                  bz = int(b / (size_t(v.nb[0]) * size_t(v.nb[1])));
+        bool allZero = true;
+        for (int k = 0; k < BV::kEdge && allZero; ++k)
+            for (int j = 0; j < BV::kEdge && allZero; ++j)
+                for (int i = 0; i < BV::kEdge && allZero; ++i)
+                    allZero = at(bx * BV::kCells + i, by * BV::kCells + j, bz * BV::kCells + k) == 0.0f;
+        zero[b] = allZero;
+    });
+    size_t filled = 0;
+    for (uint8_t z : zero) filled += z ? 0 : 1;
+    v.pool.reserve((filled + 1) * size_t(BV::kBrick) * size_t(volume::storageBytes(v.storage)) + 64);
+    for (int bz = 0; bz < v.nb[2]; ++bz)
+        for (int by = 0; by < v.nb[1]; ++by)
+            for (int bx = 0; bx < v.nb[0]; ++bx)
+                if (!zero[v.brickIndex(bx, by, bz)]) volume::BrickBuilder::addBrick(v, bx, by, bz, at);
+}
+
+}  // namespace
+
+Scene volumeFromView(const VolumeView& view, const std::string& source) {
+    volume::Storage storage;
+    if (view.type == "u8")
+        storage = volume::Storage::U8;
+    else if (view.type == "u16" || view.type == "i16")
+        storage = volume::Storage::U16;
+    else if (view.type == "f32")
+        storage = volume::Storage::F32;
+    else
+        throw UsageError(source, "voxel type '" + view.type + "' is not one of u8, u16, i16, f32");
+    if (!view.data) throw UsageError(source, "no voxel data");
+    for (int a = 0; a < 3; ++a)
+        if (view.dims[a] < 2)
+            throw UsageError(source, fmt("needs at least 2 voxels along every axis, got %d x %d x %d (x, y, z)",
+                                         view.dims[0], view.dims[1], view.dims[2]));
+    const Vec3f& sp = view.spacing;
+    if (!(sp.x > 0 && sp.y > 0 && sp.z > 0 && std::isfinite(sp.x) && std::isfinite(sp.y) && std::isfinite(sp.z)))
+        throw UsageError(source, "spacing must be positive and finite");
+    const Vec3f& o = view.origin;
+    if (!(std::isfinite(o.x) && std::isfinite(o.y) && std::isfinite(o.z)))
+        throw UsageError(source, "origin must be finite");
+    auto d = makeData(SceneKind::Volume, "");
+    volume::BrickedVolume& v = d->volume.vol;
+    volume::BrickBuilder::init(v, view.dims.data(), storage);
+    v.spacing = sp;
+    v.origin = o;
+    v.sourceType = view.type;
+    if (view.type == "i16") v.offset = -32768.0f;
+    if (view.type == "u8")
+        brickView<uint8_t>(view, v, source);
+    else if (view.type == "u16")
+        brickView<uint16_t>(view, v, source);
+    else if (view.type == "i16")
+        brickView<int16_t>(view, v, source);
+    else
+        brickView<float>(view, v, source);
+    try {
+        volume::BrickBuilder::finish(v);
+    } catch (const Error& e) {
+        throw Error(source, e.what());
+    }
+    finishVolume(*d);
     return Scene{d};
 }
 

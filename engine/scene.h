@@ -12,6 +12,7 @@
 #include "core/math/aabb.h"
 #include "engine/settings.h"
 #include "engine/stats.h"
+#include "points/point_cloud.h"
 #include "volume/volume_io.h"
 
 namespace rtfact::engine {
@@ -69,5 +70,26 @@ Scene spheres(int count);
 
 // `rtfact info FILE`: what a file holds, as (key, value) lines, without rendering it.
 std::vector<std::pair<std::string, std::string>> fileInfo(const std::string& file);
+
+// In-memory data without intermediate copies (the Python module's numpy inputs).
+
+// A point cloud the caller filled: positions plus optional colours, normals, radii and
+// intensities of the same count (empty: absent). Throws UsageError(`source`, ...) for a
+// size mismatch, no points, non-finite values or radii <= 0.
+Scene pointsFromCloud(points::PointCloud cloud, const std::string& source = "point arrays");
+
+// A dense volume read in place through byte strides, so any memory layout (C or Fortran
+// order, a strided slice) is bricked without a dense copy; u8/u16 stay 8/16-bit, i16 is
+// stored shifted into u16 (as the file loaders do), f32 as floats. The memory is only
+// read during the call.
+struct VolumeView {
+    const void* data = nullptr;
+    std::string type;                  // u8 | u16 | i16 | f32
+    std::array<int, 3> dims{};         // voxels along x, y, z
+    std::array<int64_t, 3> strides{};  // bytes between neighbours along x, y, z
+    Vec3f spacing{1, 1, 1}, origin{0, 0, 0};
+};
+// Throws UsageError(`source`, ...) for a bad type, dims < 2, spacing <= 0 or non-finite voxels.
+Scene volumeFromView(const VolumeView& view, const std::string& source = "volume array");
 
 }  // namespace rtfact::engine

@@ -10,6 +10,7 @@ RTFACT_PACKAGES=(
   libtbb-dev libopenimageio-dev openimageio-tools
   libpcl-dev libvtk9-dev libopenvdb-dev libembree-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest
 )
 
 rtfact_install_packages() {
