@@ -4,6 +4,7 @@
 // from the file and the domain's defaults are used; with it, every option of that render
 // command applies (CLI11 cannot register e.g. --integrator of points and mesh on one
 // command, so each domain is a subcommand of `view`).
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -72,7 +73,10 @@ void openBrowser(const std::string& url) {
 int serve(CommonOptions& c, const ViewOptions& v, const std::function<engine::Settings()>& settings,
           const std::function<engine::Scene()>& open, bool defaultPointPacket) {
     c.finalize();
-    if (v.bind.empty()) throw CLI::ValidationError("--bind", "must not be empty");
+    // A bad address is bad usage, found before the data are loaded.
+    in6_addr probe{};
+    if (inet_pton(AF_INET, v.bind.c_str(), &probe) != 1 && inet_pton(AF_INET6, v.bind.c_str(), &probe) != 1)
+        throw CLI::ValidationError("--bind", "expected an IPv4 or IPv6 address, got '" + v.bind + "'");
     engine::Settings s = settings();
     const engine::Scene scene = open();
     if (!c.quiet)

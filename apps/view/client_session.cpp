@@ -80,6 +80,7 @@ void ClientSession::handle(std::string_view text) {
     std::unique_lock l(m_);
     // Everything but acks and format changes makes the frames in the making stale.
     auto restart = [&] {
+        session_->cancel();  // the pass in flight renders an outdated view
         idle_ = false;
         ++generation_;
         accumulated_ = 0;
