@@ -65,6 +65,7 @@ class WsClient {
     WsClient(int port, const std::string& token) : ws_(ioc_) {
         ws_.next_layer().connect({net::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)});
         receiveTimeout(ws_.next_layer(), 120);
+        ws_.next_layer().set_option(tcp::no_delay(true));
         ws_.read_message_max(64u << 20);
         ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws?token=" + token);
     }

@@ -59,6 +59,10 @@ class WsConnection : public std::enable_shared_from_this<WsConnection> {
     WsConnection(tcp::socket&& socket, ViewerServer::Impl& server) : ws_(std::move(socket)), server_(server) {}
 
     void run(http::request<http::string_body> req) {
+        // Frames are a small text message and the image: without this, Nagle's algorithm
+        // holds the second behind the client's delayed ACK (tens of ms per frame).
+        beast::error_code ignored;
+        beast::get_lowest_layer(ws_).socket().set_option(tcp::no_delay(true), ignored);
         ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
         // Larger messages than this close the connection (1009); up to it, the protocol's
         // own limit (kMaxMessageBytes) answers with an error message.
