@@ -330,6 +330,9 @@ TEST(ViewerProtocol, ClientsVanishingMidFrameDoNotHurtTheServer) {
 TEST(ViewerProtocol, SeveralTabsHaveTheirOwnViews) {
     Served s(kPoints, engine::SceneKind::Points);
     WsClient a = s.client(), b = s.client();
+    // The hello comes after the server has registered the session.
+    a.until("hello");
+    b.until("hello");
     EXPECT_EQ(s.server->sessions(), 2);
     const CameraFrame ca = otherCamera(s.scene);
     CameraFrame cb = ca;
