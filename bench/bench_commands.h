@@ -7,5 +7,7 @@ int benchMesh(int argc, char** argv);
 int benchPoints(int argc, char** argv);
 int benchVolume(int argc, char** argv);
 int benchPython(int argc, char** argv);
+// The browser viewer over a socket (bench_view.cpp).
+int benchView(int argc, char** argv);
 
 }  // namespace rtfact::bench

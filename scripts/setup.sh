@@ -11,6 +11,7 @@ RTFACT_PACKAGES=(
   libpcl-dev libvtk9-dev libopenvdb-dev libembree-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   pybind11-dev python3-dev python3-numpy python3-pytest
+  libboost-dev libturbojpeg0-dev chromium chromium-driver python3-selenium
 )
 
 rtfact_install_packages() {

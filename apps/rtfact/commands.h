@@ -23,6 +23,8 @@ void addGenCommand(CLI::App& app, CommandList& list);
 void addGenPointsCommand(CLI::App& gen, CommandList& list);
 void addGenVolumeCommand(CLI::App& gen, CommandList& list);
 void addInfoCommand(CLI::App& app, CommandList& list);
+// `rtfact view`: the browser viewer (apps/view).
+void addViewCommand(CLI::App& app, CommandList& list);
 
 // "a|b|c" for option help texts.
 inline std::string joined(const std::vector<std::string>& names) {

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     addVolumeCommand(app, commands);
     addGenCommand(app, commands);
     addInfoCommand(app, commands);
+    addViewCommand(app, commands);
     try {
         app.parse(argc, argv);
         for (Command& c : commands)
