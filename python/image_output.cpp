@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/render/image_io.h"
+#include "core/render/srgb.h"
 #include "core/util/error.h"
 #include "python/errors.h"
 
@@ -61,10 +62,8 @@ py::array_t<uint8_t> toSrgb8(py::handle image) {
     const size_t n = size_t(img.width) * size_t(img.height);
     for (size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) {
-            // The sRGB curve and rounding of core/render/image_io.cpp's 8-bit writer.
-            const float v = std::clamp(img.rgba[i * 4 + size_t(c)], 0.0f, 1.0f);
-            const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-            dst[i * 3 + size_t(c)] = uint8_t(std::lround(s * 255.0f));
+            // The curve and rounding of the CLI's 8-bit image writer.
+            dst[i * 3 + size_t(c)] = linearToSrgb8(img.rgba[i * 4 + size_t(c)]);
         }
     return out;
 }

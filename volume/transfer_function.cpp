@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/render/srgb.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
 
@@ -23,11 +24,6 @@ auto interpolate(const std::vector<P>& pts, float x, F get) -> decltype(get(pts[
     const P& a = *(it - 1);
     const float w = b.x > a.x ? (x - a.x) / (b.x - a.x) : 1.0f;
     return get(a) * (1.0f - w) + get(b) * w;
-}
-
-float srgbToLinear(float c) {
-    c = std::clamp(c, 0.0f, 1.0f);
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
 TransferFunction make(const char* name, std::vector<ColorPoint> c, std::vector<OpacityPoint> o,

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "core/render/image_io.h"
+#include "core/render/srgb.h"
 #include "core/util/error.h"
 
 namespace rtfact::viewer {
@@ -24,8 +25,7 @@ const std::array<uint8_t, 4097>& srgbTable() {
         std::array<uint8_t, 4097> t{};
         for (size_t i = 0; i < t.size(); ++i) {
             const float v = float(i) / 4096.0f;
-            const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-            t[i] = uint8_t(std::lround(std::clamp(s, 0.0f, 1.0f) * 255.0f));
+            t[i] = linearToSrgb8(v);
         }
         return t;
     }();

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "core/io/file_helpers.h"
+#include "core/render/srgb.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
 #include "core/util/memory_budget.h"
@@ -59,12 +60,6 @@ std::string oneLine(std::string s) {
 
 bool isFloatFormat(const std::string& ext) { return ext == ".exr" || ext == ".hdr"; }
 
-float toSRGB(float v) {
-    v = std::clamp(v, 0.0f, 1.0f);
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-float fromSRGB(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
-
 std::string tempPathFor(const std::string& path) {
     const fs::path p(path);
     std::random_device rd;
@@ -106,8 +101,7 @@ void writeImage(const std::string& path, int width, int height, const std::vecto
             std::vector<unsigned char> px(size_t(width) * size_t(height) * size_t(channels));
             for (size_t i = 0, n = size_t(width) * size_t(height); i < n; ++i) {
                 for (int c = 0; c < channels; ++c) {
-                    const float v = toSRGB(rgba[i * 4 + size_t(c)]);
-                    px[i * size_t(channels) + size_t(c)] = (unsigned char)std::lround(v * 255.0f);
+                    px[i * size_t(channels) + size_t(c)] = linearToSrgb8(rgba[i * 4 + size_t(c)]);
                 }
             }
             ok = out->write_image(OIIO::TypeDesc::UINT8, px.data());
@@ -164,7 +158,7 @@ Image readImage(const std::string& path) {
         if (!std::isfinite(v)) throw Error(path, "image holds NaN or infinite values");
     if (spec.format == OIIO::TypeDesc::UINT8) {
         for (size_t i = 0; i < img.pixels.size(); ++i)
-            if (img.channels < 4 || i % size_t(img.channels) != 3) img.pixels[i] = fromSRGB(img.pixels[i]);
+            if (img.channels < 4 || i % size_t(img.channels) != 3) img.pixels[i] = srgbToLinear(img.pixels[i]);
     }
     return img;
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/render/image_io.h"
+#include "core/render/srgb.h"
 
 namespace rtfact::test {
 
@@ -29,11 +30,7 @@ struct ImageDiff {
     int maxChannelDiff = 0;
 };
 
-inline int toByte(float linear) {
-    const float v = std::clamp(linear, 0.0f, 1.0f);
-    const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-    return int(std::lround(s * 255.0f));
-}
+inline int toByte(float linear) { return linearToSrgb8(linear); }
 
 // Compares two RGBA float images (same size) with the metric above.
 inline ImageDiff compareRGBA(const std::vector<float>& a, const std::vector<float>& b, int w, int h, int tol) {
