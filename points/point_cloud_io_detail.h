@@ -41,4 +41,5 @@ namespace rtfact::points {
 std::optional<PointFileInfo> probePly(const std::string& file);
 std::optional<PointFileInfo> probePcd(const std::string& file);
 std::optional<PointFileInfo> probeXyz(const std::string& file);
+std::optional<PointFileInfo> probeLas(const std::string& file);
 }  // namespace rtfact::points
