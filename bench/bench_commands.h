@@ -6,5 +6,6 @@ namespace rtfact::bench {
 int benchMesh(int argc, char** argv);
 int benchPoints(int argc, char** argv);
 int benchVolume(int argc, char** argv);
+int benchLoad(int argc, char** argv);
 
 }  // namespace rtfact::bench

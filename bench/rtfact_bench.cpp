@@ -1,4 +1,4 @@
-// rtfact-bench mesh|points|volume FILE [options]: RTfact against its peer in one process.
+// rtfact-bench mesh|points|volume|load FILE [options]: RTfact against its peer in one process.
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -9,13 +9,14 @@
 int main(int argc, char** argv) {
     using namespace rtfact::bench;
     if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-        std::printf("usage: rtfact-bench mesh|points|volume FILE [options]   (rtfact-bench CMD --help)\n");
+        std::printf("usage: rtfact-bench mesh|points|volume|load FILE [options]   (rtfact-bench CMD --help)\n");
         return argc < 2 ? 2 : 0;
     }
     try {
         if (!std::strcmp(argv[1], "mesh")) return benchMesh(argc - 1, argv + 1);
         if (!std::strcmp(argv[1], "points")) return benchPoints(argc - 1, argv + 1);
         if (!std::strcmp(argv[1], "volume")) return benchVolume(argc - 1, argv + 1);
+        if (!std::strcmp(argv[1], "load")) return benchLoad(argc - 1, argv + 1);
     } catch (const rtfact::Error& e) {
         std::fprintf(stderr, "rtfact-bench: error: %s\n", e.message().c_str());
         return 1;
@@ -23,6 +24,6 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "rtfact-bench: error: %s\n", e.what());
         return 1;
     }
-    std::fprintf(stderr, "rtfact-bench: error: unknown benchmark '%s' (mesh, points, volume)\n", argv[1]);
+    std::fprintf(stderr, "rtfact-bench: error: unknown benchmark '%s' (mesh, points, volume, load)\n", argv[1]);
     return 2;
 }
