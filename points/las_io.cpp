@@ -7,6 +7,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <atomic>
@@ -226,28 +227,40 @@ Summary summarize(const std::string& file) {
 
 using namespace las;
 
+namespace {
+// The attribute names a file of this layout holds (x y z ..., then its extra bytes).
+std::vector<std::string> propertiesOf(const Header& h, const std::vector<ExtraField>& extra) {
+    const Layout l = layoutOf(h.pointFormat);
+    std::vector<std::string> p = {"x",
+                                  "y",
+                                  "z",
+                                  "intensity",
+                                  "return_number",
+                                  "number_of_returns",
+                                  "classification",
+                                  "scan_angle",
+                                  "user_data",
+                                  "point_source_id"};
+    if (l.gps >= 0) p.push_back("gps_time");
+    if (l.rgb >= 0) p.insert(p.end(), {"red", "green", "blue"});
+    if (l.nir >= 0) p.push_back("nir");
+    for (const ExtraField& e : extra) p.push_back(e.name);
+    return p;
+}
+
+std::string formatName(const Header& h) {
+    return std::string(h.compressed ? "laz " : "las ") + std::to_string(h.versionMajor) + "." +
+           std::to_string(h.versionMinor) + " format " + std::to_string(h.pointFormat);
+}
+}  // namespace
+
 std::optional<PointFileInfo> probeLas(const std::string& file) {
     io::MappedFile m(file);
     const Header h = readHeader(bytesOf(m), file);
     PointFileInfo info;
-    info.format = std::string(h.compressed ? "laz " : "las ") + std::to_string(h.versionMajor) + "." +
-                  std::to_string(h.versionMinor) + " format " + std::to_string(h.pointFormat);
+    info.format = formatName(h);
     info.points = h.pointCount;
-    const Layout l = layoutOf(h.pointFormat);
-    info.properties = {"x",
-                       "y",
-                       "z",
-                       "intensity",
-                       "return_number",
-                       "number_of_returns",
-                       "classification",
-                       "scan_angle",
-                       "user_data",
-                       "point_source_id"};
-    if (l.gps >= 0) info.properties.push_back("gps_time");
-    if (l.rgb >= 0) info.properties.insert(info.properties.end(), {"red", "green", "blue"});
-    if (l.nir >= 0) info.properties.push_back("nir");
-    for (const ExtraField& e : parseExtraBytes(h, bytesOf(m), file)) info.properties.push_back(e.name);
+    info.properties = propertiesOf(h, parseExtraBytes(h, bytesOf(m), file));
     return info;
 }
 
@@ -285,61 +298,114 @@ PointCloud loadLas(const std::string& file, const LoadFilter& filter, int thread
                 "crop the tile first, e.g. with pdal or lastools");
 
     PointCloud c;
-    c.format = std::string(h.compressed ? "laz " : "las ") + std::to_string(h.versionMajor) + "." +
-               std::to_string(h.versionMinor) + " format " + std::to_string(h.pointFormat);
+    c.format = formatName(h);
     c.crs = crsText(h, f);
     auto coord = [&](const uint8_t* p, int a) { return double(le<int32_t>(p + 4 * a)) * h.scale[a] + h.offset[a]; };
+    // (the decode below computes the same expression: x * scale + offset - origin)
     // The origin shift of the other loaders: the first point, rounded, when far from 0.
     const double p0[3] = {coord(r.record(0), 0), coord(r.record(0), 1), coord(r.record(0), 2)};
     if (std::max({std::fabs(p0[0]), std::fabs(p0[1]), std::fabs(p0[2])}) > 1e4)
         c.origin = {std::round(p0[0]), std::round(p0[1]), std::round(p0[2])};
-    c.properties = probeLas(file)->properties;
+    c.properties = propertiesOf(h, extra);
 
-    resizeHuge(c.positions, n);
-    c.intensities.resize(n);
-    c.classes.resize(n);
-    c.returnNumbers.resize(n);
-    c.returnCounts.resize(n);
-    if (l.rgb >= 0) c.colors.resize(n);
     c.scalars.resize(scalars.size());
     for (size_t k = 0; k < scalars.size(); ++k) {
         c.scalars[k].name = scalars[k].name;
-        c.scalars[k].values.resize(n);
         // Large values (GPS seconds) keep their precision relative to the first point's.
         if (scalars[k].name == "gps_time") c.scalars[k].offset = extraValue(r.record(0) + scalars[k].offset, 10);
     }
     std::atomic<uint16_t> maxRgb{0};
     const std::array<double, 3> o = c.origin;
+    const uint32_t stride = h.recordLength;
     withThreads(threads, [&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 15), [&](const tbb::blocked_range<size_t>& br) {
-            uint16_t localMax = 0;
-            for (size_t i = br.begin(); i < br.end(); ++i) {
-                const uint8_t* p = r.record(i);
-                c.positions[i] = Vec3f(float(coord(p, 0) - o[0]), float(coord(p, 1) - o[1]), float(coord(p, 2) - o[2]));
-                c.intensities[i] = float(le<uint16_t>(p + 12));
-                if (l.legacy) {
-                    c.returnNumbers[i] = p[14] & 7;
-                    c.returnCounts[i] = (p[14] >> 3) & 7;
-                    c.classes[i] = p[15] & 31;
-                } else {
-                    c.returnNumbers[i] = p[14] & 15;
-                    c.returnCounts[i] = p[14] >> 4;
-                    c.classes[i] = p[16];
+        // Fresh memory on huge pages, the arrays first-touched side by side: zeroing new
+        // pages costs as much as decoding on a VM.
+        tbb::task_group g;
+        g.run([&] { resizeHuge(c.positions, n); });
+        g.run([&] { resizeHuge(c.intensities, n); });
+        g.run([&] {
+            resizeHuge(c.classes, n);
+            resizeHuge(c.returnNumbers, n);
+            resizeHuge(c.returnCounts, n);
+            if (l.rgb >= 0) resizeHuge(c.colors, n);
+        });
+        for (ScalarField& f : c.scalars) g.run([&f, n] { resizeHuge(f.values, n); });
+        g.wait();
+        // Blocks that stay in L2 while every field is read out of them; raw pointers, so
+        // that the byte stores do not make the compiler reload the arrays' addresses.
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& br) {
+            const size_t b = br.begin(), e = br.end();
+            const uint8_t* base = r.data;
+            Vec3f* pos = c.positions.data();
+            float* inten = c.intensities.data();
+            uint8_t *cls = c.classes.data(), *rn = c.returnNumbers.data(), *rc = c.returnCounts.data();
+            const double s0 = h.scale[0], s1 = h.scale[1], s2 = h.scale[2];
+            const double a0 = h.offset[0], a1 = h.offset[1], a2 = h.offset[2];
+            for (size_t i = b; i < e; ++i) {
+                const uint8_t* p = base + i * stride;
+                pos[i] = Vec3f(float(double(le<int32_t>(p)) * s0 + a0 - o[0]),
+                               float(double(le<int32_t>(p + 4)) * s1 + a1 - o[1]),
+                               float(double(le<int32_t>(p + 8)) * s2 + a2 - o[2]));
+                inten[i] = float(le<uint16_t>(p + 12));
+                const uint8_t flags = p[14];
+                rn[i] = l.legacy ? flags & 7 : flags & 15;
+                rc[i] = l.legacy ? (flags >> 3) & 7 : flags >> 4;
+                cls[i] = l.legacy ? p[15] & 31 : p[16];
+            }
+            if (l.rgb >= 0) {
+                std::array<uint8_t, 3>* col = c.colors.data();
+                uint16_t localMax = 0;
+                for (size_t i = b; i < e; ++i) {
+                    const uint8_t* p = base + i * stride + l.rgb;
+                    const uint16_t rr = le<uint16_t>(p), gg = le<uint16_t>(p + 2), bb = le<uint16_t>(p + 4);
+                    localMax = std::max({localMax, rr, gg, bb});
+                    col[i] = {uint8_t(rr >> 8), uint8_t(gg >> 8), uint8_t(bb >> 8)};
                 }
-                if (l.rgb >= 0) {
-                    const uint16_t rgb[3] = {le<uint16_t>(p + l.rgb), le<uint16_t>(p + l.rgb + 2),
-                                             le<uint16_t>(p + l.rgb + 4)};
-                    localMax = std::max({localMax, rgb[0], rgb[1], rgb[2]});
-                    c.colors[i] = {uint8_t(rgb[0] >> 8), uint8_t(rgb[1] >> 8), uint8_t(rgb[2] >> 8)};
-                }
-                for (size_t k = 0; k < scalars.size(); ++k) {
-                    const Scalar& s = scalars[k];
-                    const double v = extraValue(p + s.offset, s.type) * s.scale + s.add;
-                    c.scalars[k].values[i] = float(v - c.scalars[k].offset);
+                uint16_t m = maxRgb.load();
+                while (localMax > m && !maxRgb.compare_exchange_weak(m, localMax)) {
                 }
             }
-            uint16_t m = maxRgb.load();
-            while (localMax > m && !maxRgb.compare_exchange_weak(m, localMax)) {
+            for (size_t k = 0; k < scalars.size(); ++k) {
+                const Scalar& sc = scalars[k];
+                float* out = c.scalars[k].values.data();
+                const double scale = sc.scale, add = sc.add - c.scalars[k].offset;
+                const uint8_t* p = base + sc.offset;
+                // One loop per stored type: no switch per value.
+                auto run = [&]<class T>(T) {
+                    for (size_t i = b; i < e; ++i) out[i] = float(double(le<T>(p + i * stride)) * scale + add);
+                };
+                switch (sc.type) {
+                    case 1:
+                        run(uint8_t{});
+                        break;
+                    case 2:
+                        run(int8_t{});
+                        break;
+                    case 3:
+                        run(uint16_t{});
+                        break;
+                    case 4:
+                        run(int16_t{});
+                        break;
+                    case 5:
+                        run(uint32_t{});
+                        break;
+                    case 6:
+                        run(int32_t{});
+                        break;
+                    case 7:
+                        run(uint64_t{});
+                        break;
+                    case 8:
+                        run(int64_t{});
+                        break;
+                    case 9:
+                        run(float{});
+                        break;
+                    default:
+                        run(double{});
+                        break;
+                }
             }
         });
     });
