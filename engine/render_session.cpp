@@ -144,7 +144,8 @@ PassResult RenderSession::renderSamples(int n) {
                         "a " + std::to_string(w) + "x" + std::to_string(h) + " framebuffer", "use a smaller --size");
             first_ = std::make_unique<RGBAFramebuffer>(w, h, edl);
         }
-        if (accumGeneration_ != generation || resize) {
+        const bool restart = accumGeneration_ != generation || resize;
+        if (restart) {
             sum_.clear();
             samples_ = 0;
             accumGeneration_ = generation;
@@ -152,7 +153,12 @@ PassResult RenderSession::renderSamples(int n) {
             // The first pass moves to the sum; first_ becomes the pass buffer.
             sum_.assign(first_->rawRGBA(), first_->rawRGBA() + size_t(w) * size_t(h) * 4);
         }
-        if (!resize) first_->clear();
+        // The depth (for EDL) stays the minimum over the accumulated passes, as in one pass
+        // of all their samples.
+        if (restart && !resize)
+            first_->clear();
+        else if (!resize)
+            first_->clearColor();
         ro.firstSample = samples_;
     }
     ro.threads = opts_.threads;

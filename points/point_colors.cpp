@@ -82,9 +82,10 @@ Vec3f sample(const Map& m, float t) {
     return c;
 }
 
+// Colours a writer filled with zeros are no colours.
 bool realColors(const PointCloud& c) {
     if (c.colors.size() != c.size()) return false;
-    return std::any_of(c.colors.begin(), c.colors.end(), [&](const auto& k) { return k != c.colors[0]; });
+    return std::any_of(c.colors.begin(), c.colors.end(), [](const auto& k) { return k[0] | k[1] | k[2]; });
 }
 
 }  // namespace
