@@ -9,5 +9,6 @@ int benchVolume(int argc, char** argv);
 int benchPython(int argc, char** argv);
 // The browser viewer over a socket (bench_view.cpp).
 int benchView(int argc, char** argv);
+int benchLoad(int argc, char** argv);
 
 }  // namespace rtfact::bench

@@ -1,4 +1,4 @@
-// rtfact-bench mesh|points|volume FILE [options]: RTfact against its peer in one process.
+// rtfact-bench mesh|points|volume|load FILE [options]: RTfact against its peer in one process.
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
     using namespace rtfact::bench;
     if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
         std::printf(
-            "usage: rtfact-bench mesh|points|volume|view FILE [options] | python [options]   (rtfact-bench CMD "
+            "usage: rtfact-bench mesh|points|volume|view|load FILE [options] | python [options]   (rtfact-bench CMD "
             "--help)\n");
         return argc < 2 ? 2 : 0;
     }
@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
         if (!std::strcmp(argv[1], "volume")) return benchVolume(argc - 1, argv + 1);
         if (!std::strcmp(argv[1], "python")) return benchPython(argc - 1, argv + 1);
         if (!std::strcmp(argv[1], "view")) return benchView(argc - 1, argv + 1);
+        if (!std::strcmp(argv[1], "load")) return benchLoad(argc - 1, argv + 1);
     } catch (const rtfact::Error& e) {
         std::fprintf(stderr, "rtfact-bench: error: %s\n", e.message().c_str());
         return 1;
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "rtfact-bench: error: %s\n", e.what());
         return 1;
     }
-    std::fprintf(stderr, "rtfact-bench: error: unknown benchmark '%s' (mesh, points, volume, view, python)\n", argv[1]);
+    std::fprintf(stderr, "rtfact-bench: error: unknown benchmark '%s' (mesh, points, volume, view, load, python)\n",
+                 argv[1]);
     return 2;
 }

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/io/file_helpers.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
 #include "engine/scene.h"
+#include "points/las_io.h"
 #include "points/point_cloud_io.h"
 #include "surfaces/mesh_loader.h"
 #include "volume/default_transfer_function.h"
@@ -89,6 +91,44 @@ Lines pointsInfo(const std::string& file, const points::PointFileInfo& info) {
     return l;
 }
 
+// LAS/LAZ: the header, the counts by return and class of the points themselves, the CRS
+// text and every VLR.
+Lines lasInfo(const std::string& file) {
+    static const char* classNames[] = {"never classified",  "unclassified",    "ground",         "low vegetation",
+                                       "medium vegetation", "high vegetation", "building",       "low noise",
+                                       "reserved",          "water",           "rail",           "road surface",
+                                       "reserved",          "wire guard",      "wire conductor", "transmission tower",
+                                       "wire connector",    "bridge deck",     "high noise"};
+    const points::las::Summary s = points::las::summarize(file);
+    const points::las::Header& h = s.header;
+    Lines l;
+    l.emplace_back("file", file);
+    l.emplace_back("type", "point cloud");
+    l.emplace_back("format", fmt("%s %d.%d, point format %d, %d-byte records", h.compressed ? "LAZ" : "LAS",
+                                 h.versionMajor, h.versionMinor, h.pointFormat, h.recordLength));
+    l.emplace_back("points", fmt("%llu", (unsigned long long)h.pointCount));
+    std::string ret;
+    for (auto [r, n] : s.byReturn) ret += fmt("%s%d: %llu", ret.empty() ? "" : ", ", r, (unsigned long long)n);
+    l.emplace_back("by return", ret);
+    std::string cls;
+    for (auto [c, n] : s.byClass)
+        cls += fmt("%s%d %s: %llu", cls.empty() ? "" : ", ", c, c < 19 ? classNames[c] : "user defined",
+                   (unsigned long long)n);
+    l.emplace_back("by class", cls);
+    l.emplace_back("bounds", fmt("[%.15g %.15g %.15g] - [%.15g %.15g %.15g]", h.min[0], h.min[1], h.min[2], h.max[0],
+                                 h.max[1], h.max[2]));
+    l.emplace_back("scale", fmt("%.15g %.15g %.15g", h.scale[0], h.scale[1], h.scale[2]));
+    l.emplace_back("offset", fmt("%.15g %.15g %.15g", h.offset[0], h.offset[1], h.offset[2]));
+    l.emplace_back("crs", s.crs.empty() ? "none" : s.crs);
+    l.emplace_back("software", h.software + (h.systemId.empty() ? "" : " (" + h.systemId + ")"));
+    for (const points::las::ExtraField& e : s.extra) l.emplace_back("extra bytes", e.name);
+    for (const points::las::Vlr& v : h.vlrs)
+        l.emplace_back(v.extended ? "evlr" : "vlr",
+                       fmt("%s %u (%llu bytes)%s%s", v.userId.c_str(), v.recordId, (unsigned long long)v.size,
+                           v.description.empty() ? "" : ": ", v.description.c_str()));
+    return l;
+}
+
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> fileInfo(const std::string& file) {
@@ -96,6 +136,7 @@ std::vector<std::pair<std::string, std::string>> fileInfo(const std::string& fil
     requireFileOrDirectory(file);
     if (volume::looksLikeVolume(file)) return volumeInfo(file);
     if (const MeshFileKind k = meshFileKind(file); k != MeshFileKind::NotMesh) return meshInfo(file, k);
+    if (const std::string e = io::lowerExt(file); e == ".las" || e == ".laz") return lasInfo(file);
     if (const auto info = points::probePointFile(file)) return pointsInfo(file, *info);
     throw Error(file, "unknown file type");
 }

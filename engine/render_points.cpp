@@ -53,7 +53,10 @@ std::shared_ptr<PointScene> buildPointScene(SceneData& d, const PointSettings& s
                                             Stats& stats) {
     PointData& pd = d.points;
     const std::string prepareKey = s.normals + "|" + std::to_string(s.radius) + "|" + std::to_string(s.radiusFactor);
-    const std::string buildKey = prepareKey + "|" + std::to_string(int(s.color)) + "|" + std::to_string(s.leafSize);
+    const std::string range =
+        s.colorRange ? std::to_string((*s.colorRange)[0]) + "," + std::to_string((*s.colorRange)[1]) : "";
+    const std::string buildKey = prepareKey + "|" + std::to_string(int(s.color)) + "|" + s.colorAttribute + "|" +
+                                 s.colormap + "|" + range + "|" + std::to_string(s.leafSize);
     if (pd.buildKey != buildKey) {
         if (pd.sourceReleased)
             throw UsageError("settings",
@@ -79,7 +82,12 @@ std::shared_ptr<PointScene> buildPointScene(SceneData& d, const PointSettings& s
         auto scene = std::make_shared<PointScene>();
         scene->colorMode = s.color;
         {
-            std::vector<points::Disc> discs = points::makeDiscs(pd.cloud, s.color);
+            points::ColorOptions co;
+            co.mode = s.color;
+            co.attribute = s.colorAttribute;
+            co.colormap = s.colormap;
+            co.range = s.colorRange;
+            std::vector<points::Disc> discs = points::makeDiscs(pd.cloud, co, d.source);
             // the discs hold everything rendering needs
             if (!d.keepSource) {
                 pd.cloud = points::PointCloud{};

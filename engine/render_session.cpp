@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/render/eye_dome_lighting.h"
 #include "core/util/memory_budget.h"
 #include "engine/renderable.h"
 
@@ -33,6 +34,15 @@ std::unique_ptr<Renderable> makeRenderable(SceneData& d, const Settings& s, cons
 }
 
 }  // namespace
+
+// Eye-dome lighting strength of these settings (0: none): point clouds only; by default
+// on for clouds whose file had no normals (estimated normals shade them poorly).
+float edlStrength(const SceneData& d, const Settings& s) {
+    if (d.kind != SceneKind::Points) return 0.0f;
+    if (s.points.edl) return *s.points.edl;
+    return d.info.get("normals") == "none" ? 1.0f : 0.0f;
+}
+
 }  // namespace detail
 
 int defaultPacketSize(SceneKind kind) { return kind == SceneKind::Points ? 16 : 64; }
@@ -124,16 +134,18 @@ PassResult RenderSession::renderSamples(int n) {
     const int w = std::max(1, opts_.width / scale), h = std::max(1, opts_.height / scale);
     {
         std::lock_guard l(state_);
-        const bool resize = !first_ || first_->width() != w || first_->height() != h;
+        const bool edl = detail::edlStrength(data, settings) > 0;
+        const bool resize = !first_ || first_->width() != w || first_->height() != h || first_->hasDepth() != edl;
         if (resize) {
             first_.reset();
             sum_.clear();
             // Accumulation buffer, resolved copy and 8-bit output.
-            checkMemory(opts_.target, uint64_t(w) * uint64_t(h) * 36u,
+            checkMemory(opts_.target, uint64_t(w) * uint64_t(h) * (edl ? 44u : 36u),
                         "a " + std::to_string(w) + "x" + std::to_string(h) + " framebuffer", "use a smaller --size");
-            first_ = std::make_unique<RGBAFramebuffer>(w, h);
+            first_ = std::make_unique<RGBAFramebuffer>(w, h, edl);
         }
-        if (accumGeneration_ != generation || resize) {
+        const bool restart = accumGeneration_ != generation || resize;
+        if (restart) {
             sum_.clear();
             samples_ = 0;
             accumGeneration_ = generation;
@@ -141,7 +153,12 @@ PassResult RenderSession::renderSamples(int n) {
             // The first pass moves to the sum; first_ becomes the pass buffer.
             sum_.assign(first_->rawRGBA(), first_->rawRGBA() + size_t(w) * size_t(h) * 4);
         }
-        if (!resize) first_->clear();
+        // The depth (for EDL) stays the minimum over the accumulated passes, as in one pass
+        // of all their samples.
+        if (restart && !resize)
+            first_->clear();
+        else if (!resize)
+            first_->clearColor();
         ro.firstSample = samples_;
     }
     ro.threads = opts_.threads;
@@ -197,6 +214,9 @@ Frame RenderSession::frame() const {
         f.rgba.resize(sum_.size());
         for (size_t i = 0; i < sum_.size(); ++i) f.rgba[i] = sum_[i] * inv;
     }
+    // The depth of the last pass shades the averaged colours.
+    if (samples_ > 0 && first_->hasDepth())
+        applyEyeDomeLighting(f.rgba, first_->depth(), f.width, f.height, detail::edlStrength(*scene_.data, settings_));
     return f;
 }
 

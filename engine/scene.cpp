@@ -48,6 +48,15 @@ volume::DefaultTransferFunction defaultTF(const volume::BrickedVolume& v) {
                                                  volume::typicalDepthVoxels(v.dims, v.spacing));
 }
 
+// The view presets of point clouds (LAS convention: z up, y north).
+DefaultView pointView(const AABB& focus, const std::string& preset) {
+    if (preset == "top") return {focus, {0.0f, 0.0f, 1.0f}, {0, 1, 0}};
+    if (preset == "oblique") return {focus, {0.35f, -0.8f, 0.75f}, {0, 0, 1}};
+    if (preset == "front") return {focus, {0.0f, -1.0f, 0.08f}, {0, 0, 1}};
+    if (preset == "side") return {focus, {1.0f, 0.0f, 0.08f}, {0, 0, 1}};
+    return {focus};
+}
+
 void finishPoints(SceneData& d) {
     const points::PointCloud& c = d.points.cloud;
     d.bounds = c.bounds();
@@ -58,6 +67,18 @@ void finishPoints(SceneData& d) {
     d.info.add("normals", c.normals.empty() ? "none" : "yes");
     d.info.add("colors", c.colors.empty() ? "none" : "yes");
     d.info.add("radii", c.radii.empty() ? "none" : "yes");
+    if (!c.classes.empty()) d.info.add("classification", "yes");
+    if (!c.scalars.empty()) {
+        std::string names;
+        for (const points::ScalarField& f : c.scalars) names += (names.empty() ? "" : " ") + f.name;
+        d.info.add("attributes", names);
+    }
+    if (!c.crs.empty()) d.info.add("crs", c.crs.size() > 80 ? c.crs.substr(0, 77) + "..." : c.crs);
+    // A flat georeferenced cloud (an airborne tile: z up, extent far below x/y) is seen
+    // from above at an angle; head-on it would be a line.
+    const Vec3f e = d.bounds.extent();
+    const bool georeferenced = !c.crs.empty() || c.origin != std::array<double, 3>{0, 0, 0};
+    if (georeferenced && e.z < 0.25f * std::max(e.x, e.y)) d.view = pointView(d.bounds, "oblique");
 }
 
 void finishMesh(SceneData& d) {
@@ -124,6 +145,11 @@ DefaultView Scene::defaultView(const Settings& s) const {
         }
         v.focus = AABB{vol.origin + lo * vol.spacing, vol.origin + hi * vol.spacing};
     }
+    if (data->kind == SceneKind::Points && s.points.view != "auto") {
+        if (s.points.view != "top" && s.points.view != "oblique" && s.points.view != "front" && s.points.view != "side")
+            throw UsageError("--view", "'" + s.points.view + "' is not one of auto, top, oblique, front, side");
+        v = pointView(v.focus, s.points.view);
+    }
     return v;
 }
 
@@ -154,7 +180,7 @@ Scene open(const std::vector<std::string>& files, const OpenOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     switch (kind) {
         case SceneKind::Points: {
-            d->points.cloud = points::loadPointCloud(files[0]);
+            d->points.cloud = points::loadPointCloud(files[0], opt.points);
             const double ms = msSince(t0);
             const size_t n = d->points.cloud.size();
             d->load.add("load_ms", ms);

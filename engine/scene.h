@@ -13,6 +13,7 @@
 #include "engine/settings.h"
 #include "engine/stats.h"
 #include "points/point_cloud.h"
+#include "points/point_cloud_io.h"
 #include "volume/volume_io.h"
 
 namespace rtfact::engine {
@@ -54,9 +55,10 @@ struct OpenOptions {
     // Keep the loaded cloud/mesh after building, so that settings which change the
     // build (radii, colour mode, material, BVH) can rebuild; off saves the memory.
     bool keepSource = true;
+    points::LoadFilter points;  // point clouds: --classes --returns --crop, applied while loading
 };
 
-// Opens a point cloud (.ply without faces, .pcd, .xyz/.pts), meshes (several are merged),
+// Opens a point cloud (.ply without faces, .pcd, .xyz/.pts, .las/.laz), meshes (several are merged),
 // or a volume (.raw .mhd .nrrd .nii .vti .vdb, a DICOM directory). Throws Error.
 Scene open(const std::vector<std::string>& files, const OpenOptions& opt = {});
 

@@ -2,6 +2,7 @@
 // the library's defaults. Integrator and mode names map to types through one table per
 // domain (pointIntegrators() ... in the render units); unknown names throw UsageError.
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,8 +18,13 @@ enum class SceneKind { Points, Mesh, Volume, Spheres };
 const char* kindName(SceneKind k);
 
 struct PointSettings {
-    std::string integrator = "eyelight";  // pointIntegrators()
-    points::ColorMode color = points::ColorMode::Rgb;
+    std::string integrator = "eyelight";                // pointIntegrators()
+    points::ColorMode color = points::ColorMode::Auto;  // auto: the file's colours if real, else elevation
+    std::string colorAttribute;                         // ColorMode::Attribute: the scalar's name
+    std::string colormap;                               // empty: the mode's default (points::colormapNames())
+    std::optional<std::array<float, 2>> colorRange;     // none: robust percentiles
+    std::optional<float> edl;      // eye-dome lighting strength (0: off); none: on for clouds without file normals
+    std::string view = "auto";     // default camera: auto|top|oblique|front|side
     bool lod = true;               // off: full detail
     float lodQuality = 2.0f;       // node answered by its representative when size < footprint x Q
     std::string normals = "auto";  // auto|estimate|file

@@ -342,7 +342,8 @@ PointCloud loadPcd(const std::string& file) {
         ScalarType type;
         size_t offset;
     };
-    std::vector<Slot> slots;
+    std::vector<Slot> slots, scalarSlots;  // scalarSlots: attr holds the scalar's index
+    PointSink sink;
     int rgbOffset = -1;
     bool has[int(Attr::Count)] = {};
     PointCloud cloud;
@@ -357,19 +358,24 @@ PointCloud loadPcd(const std::string& file) {
             continue;
         }
         const Attr a = attrOf(name);
+        if (a == Attr::None && scalarAttribute(name)) {
+            scalarSlots.push_back({Attr(sink.scalars.size()), t, offset});
+            sink.scalars.push_back({name, {}});
+        }
         if (a == Attr::None || a == Attr::R || a == Attr::G || a == Attr::B || has[int(a)]) continue;
         has[int(a)] = true;
         slots.push_back({a, t, offset});
     }
     if (!has[int(Attr::X)] || !has[int(Attr::Y)] || !has[int(Attr::Z)]) throw Error(file, "PCD points lack x, y or z");
     const bool hasN = has[int(Attr::NX)] && has[int(Attr::NY)] && has[int(Attr::NZ)];
-    PointSink sink;
     sink.reserve(file, n, hasN, rgbOffset >= 0, has[int(Attr::Radius)], has[int(Attr::Intensity)]);
     for (size_t i = 0; i < n; ++i) {
         const char* rec = rows.data() + i * row;
         // Separate R/G/B fields are skipped above: colour comes from the packed rgb only.
         for (const Slot& s : slots)
             storeAttr(sink, i, s.attr, io::decodeScalar(rec + s.offset, s.type, false), s.type, hasN, false);
+        for (const Slot& s : scalarSlots)
+            sink.scalars[size_t(s.attr)].values[i] = float(io::decodeScalar(rec + s.offset, s.type, false));
         if (rgbOffset >= 0) {
             uint32_t packed;  // 0x00RRGGBB whatever the declared type (F or U)
             std::memcpy(&packed, rec + rgbOffset, 4);

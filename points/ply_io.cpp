@@ -52,6 +52,10 @@ Attr attrOf(const std::string& name) {
     return Attr::None;
 }
 
+bool scalarAttribute(const std::string& name) {
+    return name.rfind("scalar_", 0) == 0 || name == "class" || name == "classification" || name == "label";
+}
+
 uint8_t colorByte(double v, ScalarType t) {
     if (t == ScalarType::F32 || t == ScalarType::F64)
         v *= 255.0;
@@ -64,7 +68,8 @@ uint8_t colorByte(double v, ScalarType t) {
 // Collects one decoded point; finite check and origin shift happen in finish().
 void PointSink::reserve(const std::string& file, size_t n, bool normals, bool colors, bool radius, bool intensity) {
     // Decoded (double positions) and final (float) copies live together in finish().
-    const uint64_t perPoint = 24 + 12 + (normals ? 24 : 0) + (colors ? 6 : 0) + (radius ? 8 : 0) + (intensity ? 8 : 0);
+    const uint64_t perPoint =
+        24 + 12 + (normals ? 24 : 0) + (colors ? 6 : 0) + (radius ? 8 : 0) + (intensity ? 8 : 0) + 8 * scalars.size();
     checkMemory(file, uint64_t(n) * perPoint, "loading " + std::to_string(n) + " points",
                 "subsample the cloud, e.g. with pcl_voxel_grid");
     resizeHugePages(pos, n);
@@ -72,6 +77,7 @@ void PointSink::reserve(const std::string& file, size_t n, bool normals, bool co
     if (colors) resizeHugePages(col, n);
     if (radius) resizeHugePages(rad, n);
     if (intensity) resizeHugePages(inten, n);
+    for (ScalarField& f : scalars) f.values.resize(n);
 }
 
 namespace {
@@ -113,6 +119,11 @@ void PointSink::finish(const std::string& file, PointCloud& out) {
     if (!col.empty()) out.colors.resize(kept);
     if (!rad.empty()) out.radii.resize(kept);
     if (!inten.empty()) out.intensities.resize(kept);
+    out.scalars.resize(scalars.size());
+    for (size_t a = 0; a < scalars.size(); ++a) {
+        out.scalars[a].name = scalars[a].name;
+        out.scalars[a].values.resize(kept);
+    }
     const std::array<double, 3> o = out.origin;
     tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
         size_t k = start[b];
@@ -128,6 +139,7 @@ void PointSink::finish(const std::string& file, PointCloud& out) {
             if (!col.empty()) out.colors[k] = col[i];
             if (!rad.empty()) out.radii[k] = std::isfinite(rad[i]) && rad[i] > 0 ? rad[i] : 0.0f;
             if (!inten.empty()) out.intensities[k] = std::isfinite(inten[i]) ? inten[i] : 0.0f;
+            for (size_t a = 0; a < scalars.size(); ++a) out.scalars[a].values[k] = scalars[a].values[i];
             ++k;
         }
     });
@@ -136,6 +148,15 @@ void PointSink::finish(const std::string& file, PointCloud& out) {
     col = {};
     rad = {};
     inten = {};
+    scalars = {};
+    // A class/classification/label field is the classification too (colour, --classes).
+    for (const ScalarField& f : out.scalars)
+        if (f.name == "class" || f.name == "classification" || f.name == "label") {
+            out.classes.resize(kept);
+            for (size_t i = 0; i < kept; ++i)
+                out.classes[i] = uint8_t(std::clamp(std::isfinite(f.values[i]) ? f.values[i] : 0.0f, 0.0f, 255.0f));
+            break;
+        }
 }
 
 }  // namespace detail
@@ -270,7 +291,8 @@ PointCloud loadPly(const std::string& file) {
         ScalarType type;
         size_t offset;
     };
-    std::vector<Slot> slots;
+    std::vector<Slot> slots, scalarSlots;  // scalarSlots: attr holds the scalar's index
+    PointSink sink;
     bool has[int(Attr::Count)] = {};
     size_t off = 0;
     for (const auto& p : v->props) {
@@ -281,6 +303,9 @@ PointCloud loadPly(const std::string& file) {
             if (a != Attr::None && !has[int(a)]) {
                 slots.push_back({a, p.type, off});
                 has[int(a)] = true;
+            } else if (a == Attr::None && scalarAttribute(p.name)) {
+                scalarSlots.push_back({Attr(sink.scalars.size()), p.type, off});
+                sink.scalars.push_back({p.name, {}});
             }
             off += size_t(scalarBytes(p.type));
         }
@@ -292,7 +317,6 @@ PointCloud loadPly(const std::string& file) {
     for (const auto& p : v->props) cloud.properties.push_back(p.name);
     const bool hasN = has[int(Attr::NX)] && has[int(Attr::NY)] && has[int(Attr::NZ)];
     const bool hasC = has[int(Attr::R)] && has[int(Attr::G)] && has[int(Attr::B)];
-    PointSink sink;
     const size_t n = size_t(v->count);
 
     if (h.ascii()) {
@@ -331,11 +355,13 @@ PointCloud loadPly(const std::string& file) {
                 vals[slot++] = tk.number(file);
             }
             // Map values (in scalar property order) to attributes.
-            size_t s = 0;
+            size_t s = 0, named = 0;
             for (const auto& p : v->props) {
                 if (p.isList) continue;
                 const double x = vals[s++];
-                storeAttr(sink, i, attrOf(p.name), x, p.type, hasN, hasC);
+                const Attr a = attrOf(p.name);
+                storeAttr(sink, i, a, x, p.type, hasN, hasC);
+                if (a == Attr::None && scalarAttribute(p.name)) sink.scalars[named++].values[i] = float(x);
             }
         }
     } else {
@@ -368,6 +394,8 @@ PointCloud loadPly(const std::string& file) {
                     }
                     storeAttr(sink, i, s.attr, x, s.type, hasN, hasC);
                 }
+                for (const Slot& s : scalarSlots)
+                    sink.scalars[size_t(s.attr)].values[i] = float(decodeScalar(rec + s.offset, s.type, be));
             }
         });
     }

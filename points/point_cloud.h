@@ -10,12 +10,26 @@
 
 namespace rtfact::points {
 
+// A named per-point scalar the colouring can map (LAS extra bytes and GPS time, PLY
+// scalar_*, PCD label ...): value i is offset + values[i] (the offset keeps large values
+// such as GPS seconds precise in float).
+struct ScalarField {
+    std::string name;
+    std::vector<float> values;
+    double offset = 0;
+};
+
 struct PointCloud {
     std::vector<Vec3f> positions;
     std::vector<Vec3f> normals;                  // empty: none in the file
     std::vector<std::array<uint8_t, 3>> colors;  // empty: none
     std::vector<float> radii;                    // empty: none
     std::vector<float> intensities;              // empty: none
+    std::vector<uint8_t> classes;                // ASPRS classification; empty: none
+    std::vector<uint8_t> returnNumbers;          // 1-based return number; empty: none
+    std::vector<uint8_t> returnCounts;           // number of returns of the pulse; empty: none
+    std::vector<ScalarField> scalars;            // further named attributes
+    std::string crs;                             // coordinate reference system as text (WKT, GeoTIFF keys); empty: none
     std::array<double, 3> origin{0, 0, 0};       // subtracted (in double) from the file's coordinates
     Vec3f viewpoint{0, 0, 0};                    // sensor position (PCD VIEWPOINT), after the shift
     bool hasViewpoint = false;
@@ -24,6 +38,11 @@ struct PointCloud {
     std::vector<std::string> properties;  // property names found in the file
 
     size_t size() const { return positions.size(); }
+    const ScalarField* scalar(const std::string& name) const {
+        for (const ScalarField& f : scalars)
+            if (f.name == name) return &f;
+        return nullptr;
+    }
     AABB bounds() const {
         AABB b;
         for (const Vec3f& p : positions) b.extend(p);

@@ -3,15 +3,31 @@
 // XYZ/PTS text. Every loader throws rtfact::Error(file, what) on bad input and drops
 // points with non-finite coordinates (counted in droppedNonFinite).
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "points/point_cloud.h"
 
 namespace rtfact::points {
 
-// Loads any supported file, chosen by extension (.ply .pcd .xyz .pts .txt).
-PointCloud loadPointCloud(const std::string& file);
+// Points kept while loading (lidar users' --classes, --returns, --crop). Classes and
+// returns need a file that has them (LAS/LAZ; PLY/PCD with a class/label field).
+struct LoadFilter {
+    std::vector<int> classes;  // empty: all
+    enum class Returns { All, First, Last } returns = Returns::All;
+    std::optional<std::array<double, 4>> crop;  // xmin, ymin, xmax, ymax in the file's coordinates
+    bool active() const { return !classes.empty() || returns != Returns::All || crop.has_value(); }
+};
+
+// Loads any supported file, chosen by extension (.ply .pcd .xyz .pts .txt .las .laz).
+PointCloud loadPointCloud(const std::string& file, const LoadFilter& filter = {});
+// Keeps the points that pass `filter` (every per-point array follows); throws
+// Error(file, ...) when the filter needs an attribute the cloud lacks or nothing is left.
+void applyLoadFilter(PointCloud& cloud, const LoadFilter& filter, const std::string& file);
+// LAS 1.0-1.4 (formats 0-10) and LAZ; `threads` decode in parallel (0: all cores).
+PointCloud loadLas(const std::string& file, const LoadFilter& filter = {}, int threads = 0);
 // What a loaded cloud lost, as one line for a warning: "FILE: 12 points with non-finite
 // coordinates dropped"; empty when nothing was dropped.
 std::string droppedPointsMessage(const std::string& file, const PointCloud& cloud);

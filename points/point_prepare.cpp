@@ -229,38 +229,25 @@ PrepareReport preparePointCloud(PointCloud& cloud, const PrepareOptions& opt, co
     return rep;
 }
 
-ColorMode parseColorMode(const std::string& s) {
-    if (s == "rgb") return ColorMode::Rgb;
-    if (s == "intensity") return ColorMode::Intensity;
-    if (s == "lod") return ColorMode::Lod;
-    if (s == "normal") return ColorMode::Normal;
-    throw Error("", "unknown colour mode '" + s + "'");
-}
+ColorMode parseColorMode(const std::string& s) { return parseColorOptions(s).mode; }
 
 std::vector<Disc> makeDiscs(const PointCloud& c, ColorMode mode) {
+    ColorOptions o;
+    o.mode = mode;
+    return makeDiscs(c, o);
+}
+
+std::vector<Disc> makeDiscs(const PointCloud& c, const ColorOptions& color, const std::string& source) {
     const size_t n = c.size();
+    const std::vector<Vec3f> col = pointColors(c, color, source);
     std::vector<Disc> d;
     resizeFreshHugePages(d, n);
-    float iLo = 0, iHi = 1;
-    if (mode == ColorMode::Intensity && c.intensities.size() == n) {
-        iLo = *std::min_element(c.intensities.begin(), c.intensities.end());
-        iHi = *std::max_element(c.intensities.begin(), c.intensities.end());
-        if (!(iHi > iLo)) iHi = iLo + 1;
-    }
-    const bool hasC = c.colors.size() == n, hasI = c.intensities.size() == n;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i < r.end(); ++i) {
             d[i].center = c.positions[i];
             d[i].radius = c.radii.size() == n ? c.radii[i] : 0.0f;
             d[i].normal = encodeNormal(c.normals.size() == n ? c.normals[i] : Vec3f(0, 0, 1));
-            Vec3f col(0.85f, 0.85f, 0.85f);
-            if (mode == ColorMode::Rgb && hasC)
-                col = Vec3f(c.colors[i][0], c.colors[i][1], c.colors[i][2]) * (1.0f / 255.0f);
-            else if (mode == ColorMode::Intensity && hasI)
-                col = Vec3f((c.intensities[i] - iLo) / (iHi - iLo));
-            else if (mode == ColorMode::Intensity && hasC)
-                col = Vec3f((0.299f * c.colors[i][0] + 0.587f * c.colors[i][1] + 0.114f * c.colors[i][2]) / 255.0f);
-            d[i].rgba = packRGBA(col, 0);
+            d[i].rgba = packRGBA(col[i], 0);
         }
     });
     return d;

@@ -10,6 +10,7 @@
 
 #include "points/disc.h"
 #include "points/point_cloud.h"
+#include "points/point_colors.h"
 
 namespace rtfact::points {
 
@@ -46,11 +47,12 @@ std::vector<Vec3f> estimateNormals(const std::vector<Vec3f>& positions, int k, V
 // other); 0 when all points coincide.
 std::vector<float> neighbourSpacing(const std::vector<Vec3f>& positions, int k);
 
-enum class ColorMode { Rgb, Intensity, Lod, Normal };
+// The mode of a --color value (see parseColorOptions).
 ColorMode parseColorMode(const std::string& s);
 
-// Discs from a prepared cloud; the colour is the point colour (rgb), the normalised
-// intensity (intensity) or white (lod/normal: colours computed at shading time).
+// Discs from a prepared cloud, coloured by pointColors (white for lod/normal: colours
+// computed at shading time).
+std::vector<Disc> makeDiscs(const PointCloud& cloud, const ColorOptions& color, const std::string& source = "");
 std::vector<Disc> makeDiscs(const PointCloud& cloud, ColorMode mode);
 
 }  // namespace rtfact::points

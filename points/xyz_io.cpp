@@ -153,12 +153,20 @@ PointCloud loadXyz(const std::string& file) {
 
 using io::lowerExt;
 
-PointCloud loadPointCloud(const std::string& file) {
+PointCloud loadPointCloud(const std::string& file, const LoadFilter& filter) {
     const std::string e = lowerExt(file);
-    if (e == ".ply") return loadPly(file);
-    if (e == ".pcd") return loadPcd(file);
-    if (e == ".xyz" || e == ".pts" || e == ".txt" || e == ".asc") return loadXyz(file);
-    throw Error(file, "unknown point cloud format '" + e + "' (expected .ply, .pcd, .xyz, .pts)");
+    if (e == ".las" || e == ".laz") return loadLas(file, filter);
+    PointCloud c;
+    if (e == ".ply")
+        c = loadPly(file);
+    else if (e == ".pcd")
+        c = loadPcd(file);
+    else if (e == ".xyz" || e == ".pts" || e == ".txt" || e == ".asc")
+        c = loadXyz(file);
+    else
+        throw Error(file, "unknown point cloud format '" + e + "' (expected .ply, .pcd, .xyz, .pts, .las, .laz)");
+    applyLoadFilter(c, filter, file);
+    return c;
 }
 
 std::string droppedPointsMessage(const std::string& file, const PointCloud& cloud) {
@@ -172,6 +180,7 @@ std::optional<PointFileInfo> probePointFile(const std::string& file) {
     if (e == ".ply") return probePly(file);
     if (e == ".pcd") return probePcd(file);
     if (e == ".xyz" || e == ".pts") return probeXyz(file);
+    if (e == ".las" || e == ".laz") return probeLas(file);
     return std::nullopt;
 }
 

@@ -24,10 +24,10 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
     };
     auto o = std::make_shared<Opts>();
     CLI::App* cmd =
-        app.add_subcommand("points", "Render a point cloud (PLY, PCD, XYZ/PTS) as discs with a LoD kd-tree");
+        app.add_subcommand("points", "Render a point cloud (PLY, PCD, XYZ/PTS, LAS/LAZ) as discs with a LoD kd-tree");
     o->common.packet = engine::defaultPacketSize(engine::SceneKind::Points);
     o->common.addTo(*cmd, "points.png");
-    cmd->add_option("FILE", o->file, "Point cloud file (.ply .pcd .xyz .pts)")->required();
+    cmd->add_option("FILE", o->file, "Point cloud file (.ply .pcd .xyz .pts .las .laz)")->required();
     o->points.addTo(*cmd);
     list.push_back({cmd, [o] {
                         return runRenderCommand(
@@ -37,6 +37,7 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
                                 oo.kind = engine::SceneKind::Points;
                                 oo.progress = !o->common.quiet;
                                 oo.keepSource = false;
+                                oo.points = o->points.loadFilter();
                                 return engine::open({o->file}, oo);
                             });
                     }});

@@ -43,6 +43,8 @@ class RGBAFramebuffer {
         std::fill(rgba_.begin(), rgba_.end(), 0.0f);
         std::fill(depth_.begin(), depth_.end(), kInfinity);
     }
+    // Colours only: the depth keeps its minimum over the passes of one accumulation.
+    void clearColor() { std::fill(rgba_.begin(), rgba_.end(), 0.0f); }
 
    private:
     int w_, h_;
