@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/render/packet_dispatch.h"
+#include "engine/setting_text.h"
 #include "engine/usage_error.h"
 #include "python/errors.h"
 
@@ -86,14 +87,7 @@ std::vector<std::string> texts(py::handle h, const std::string& name) {
     return out;
 }
 
-Vec3f vec3Text(const std::string& s, const std::string& name) {
-    float v[3];
-    char tail = 0;
-    if (std::sscanf(s.c_str(), "%f,%f,%f%c", &v[0], &v[1], &v[2], &tail) != 3 || !std::isfinite(v[0]) ||
-        !std::isfinite(v[1]) || !std::isfinite(v[2]))
-        throwValue(name, "expected x,y,z with three finite numbers, got '" + s + "'");
-    return {v[0], v[1], v[2]};
-}
+Vec3f vec3Text(const std::string& s, const std::string& name) { return engine::parseVec3Text(s, name); }
 
 std::pair<int, int> sizeArg(py::handle h) {
     if (py::isinstance<py::str>(h)) {
@@ -112,56 +106,21 @@ std::pair<int, int> sizeArg(py::handle h) {
 
 // "axis:lo:hi" or {axis: (lo, hi)}: fractions of the axis.
 void clipArg(py::handle h, engine::VolumeSettings& s) {
-    auto apply = [&](const std::string& axis, float lo, float hi, const std::string& shown) {
-        if ((axis != "x" && axis != "y" && axis != "z") || !(lo >= 0 && hi <= 1 && lo < hi))
-            throwValue("clip", "expected axis:lo:hi with axis x|y|z and 0 <= lo < hi <= 1, got '" + shown + "'");
-        s.clipLo[axis[0] - 'x'] = lo;
-        s.clipHi[axis[0] - 'x'] = hi;
-    };
     if (py::isinstance<py::dict>(h)) {
         for (auto [k, v] : h.cast<py::dict>()) {
             const std::string axis = text(k, "clip");
             if (!py::isinstance<py::sequence>(v) || py::len(v) != 2) throwValue("clip", "expected {axis: (lo, hi)}");
             const auto seq = v.cast<py::sequence>();
-            apply(axis, float(number(seq[0], "clip")), float(number(seq[1], "clip")),
-                  axis + ":" + py::str(seq[0]).cast<std::string>() + ":" + py::str(seq[1]).cast<std::string>());
+            engine::applyClip(axis, float(number(seq[0], "clip")), float(number(seq[1], "clip")), s, "clip");
         }
         return;
     }
-    for (const std::string& c : texts(h, "clip")) {
-        char axis = 0, tail = 0;
-        float lo = 0, hi = 0;
-        if (std::sscanf(c.c_str(), "%c:%f:%f%c", &axis, &lo, &hi, &tail) != 3) apply("?", 0, 0, c);
-        apply(std::string(1, axis), lo, hi, c);
-    }
+    for (const std::string& c : texts(h, "clip")) engine::applyClipText(c, s, "clip");
 }
 
-engine::LightSpec lightArg(const std::string& s) {
-    const size_t c = s.find(':');
-    const std::string kind = c == std::string::npos ? "" : s.substr(0, c);
-    if (kind == "point") return {engine::LightSpec::Kind::Point, vec3Text(s.substr(c + 1), "light")};
-    if (kind == "dir") return {engine::LightSpec::Kind::Directional, vec3Text(s.substr(c + 1), "light")};
-    throwValue("light", "expected point:x,y,z or dir:x,y,z, got '" + s + "'");
-}
+engine::LightSpec lightArg(const std::string& s) { return engine::parseLightText(s, "light"); }
 
-MeshMaterial materialArg(const std::string& spec) {
-    const size_t c = spec.find(':');
-    const std::string kind = spec.substr(0, c), arg = c == std::string::npos ? "" : spec.substr(c + 1);
-    auto colour = [&]() -> std::optional<Vec3f> {
-        if (arg.empty()) return std::nullopt;
-        return vec3Text(arg, "material");
-    };
-    if (kind == "lambert") return engine::lambertMaterial(colour());
-    if (kind == "mirror") return engine::mirrorMaterial(colour());
-    if (kind == "glass") {
-        float ior = 1.5f;
-        char tail = 0;
-        if (!arg.empty() && (std::sscanf(arg.c_str(), "%f%c", &ior, &tail) != 1 || !std::isfinite(ior)))
-            throwValue("material", "glass:IOR expects a number, got '" + arg + "'");
-        return engine::glassMaterial(ior);
-    }
-    throwValue("material", "expected lambert[:r,g,b], mirror[:r,g,b] or glass[:ior], got '" + spec + "'");
-}
+surfaces::MeshMaterial materialArg(const std::string& spec) { return engine::parseMaterialText(spec, "material"); }
 
 // The names each kind accepts besides the shared ones.
 const std::set<std::string>& namesOf(SceneKind k) {

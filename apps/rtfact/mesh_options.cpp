@@ -1,49 +1,10 @@
 #include "apps/rtfact/mesh_options.h"
 
-#include <stdexcept>
-
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/common_options.h"
+#include "engine/setting_text.h"
 
 namespace rtfact::app {
-
-namespace {
-
-// "point:x,y,z" or "dir:x,y,z".
-engine::LightSpec parseLight(const std::string& s) {
-    const size_t c = s.find(':');
-    const std::string kind = c == std::string::npos ? "" : s.substr(0, c);
-    if (kind == "point") return {engine::LightSpec::Kind::Point, parseVec3(s.substr(c + 1), "--light")};
-    if (kind == "dir") return {engine::LightSpec::Kind::Directional, parseVec3(s.substr(c + 1), "--light")};
-    throw CLI::ValidationError("--light", "expected point:x,y,z or dir:x,y,z, got '" + s + "'");
-}
-
-// --material lambert[:r,g,b] | mirror[:r,g,b] | glass[:ior] replaces every material.
-surfaces::MeshMaterial parseMaterial(const std::string& spec) {
-    const size_t c = spec.find(':');
-    const std::string kind = spec.substr(0, c), arg = c == std::string::npos ? "" : spec.substr(c + 1);
-    auto colour = [&]() -> std::optional<Vec3f> {
-        if (arg.empty()) return std::nullopt;
-        return parseVec3(arg, "--material");
-    };
-    if (kind == "lambert") return engine::lambertMaterial(colour());
-    if (kind == "mirror") return engine::mirrorMaterial(colour());
-    if (kind == "glass") {
-        float ior = 1.5f;
-        try {
-            size_t used = 0;
-            if (!arg.empty()) ior = std::stof(arg, &used);
-            if (!arg.empty() && used != arg.size()) throw std::invalid_argument(arg);
-        } catch (const std::exception&) {
-            throw CLI::ValidationError("--material", "glass:IOR expects a number, got '" + arg + "'");
-        }
-        return engine::glassMaterial(ior);
-    }
-    throw CLI::ValidationError("--material",
-                               "expected lambert[:r,g,b], mirror[:r,g,b] or glass[:ior], got '" + spec + "'");
-}
-
-}  // namespace
 
 void MeshOptions::addTo(CLI::App& cmd) {
     cmd.add_option("--integrator", settings.integrator,
@@ -73,8 +34,8 @@ void MeshOptions::addTo(CLI::App& cmd) {
 engine::Settings MeshOptions::toSettings() const {
     engine::Settings s;
     s.mesh = settings;
-    for (const std::string& l : lights) s.mesh.lights.push_back(parseLight(l));
-    if (!material.empty()) s.mesh.material = parseMaterial(material);
+    for (const std::string& l : lights) s.mesh.lights.push_back(engine::parseLightText(l, "--light"));
+    if (!material.empty()) s.mesh.material = engine::parseMaterialText(material, "--material");
     return s;
 }
 

@@ -5,6 +5,7 @@
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/common_options.h"
 #include "core/util/error.h"
+#include "engine/setting_text.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_io.h"
 
@@ -28,19 +29,6 @@ CLI::Validator parsedBy(Parse parse, std::string description) {
             return std::string();
         },
         std::move(description));
-}
-
-void parseClip(const std::string& c, engine::VolumeSettings& s) {
-    // axis:lo:hi with axis x|y|z and lo, hi fractions of the axis in [0, 1]
-    char axis = 0;
-    float lo = 0, hi = 0;
-    char tail = 0;
-    if (std::sscanf(c.c_str(), "%c:%f:%f%c", &axis, &lo, &hi, &tail) != 3 ||
-        (axis != 'x' && axis != 'y' && axis != 'z') || !(lo >= 0 && hi <= 1 && lo < hi))
-        throw Error("--clip", "expected axis:lo:hi with axis x|y|z and 0 <= lo < hi <= 1, got '" + c + "'");
-    const int a = axis - 'x';
-    s.clipLo[a] = lo;
-    s.clipHi[a] = hi;
 }
 
 }  // namespace
@@ -72,7 +60,7 @@ void VolumeOptions::addTo(CLI::App& cmd) {
         ->check(parsedBy(
             [](const std::string& c) {
                 engine::VolumeSettings s;
-                parseClip(c, s);
+                engine::applyClipText(c, s, "--clip");
             },
             "AXIS:LO:HI"));
     cmd.add_flag("--no-skip", noSkip, "Disable empty-space skipping (for comparisons)");
@@ -82,7 +70,7 @@ engine::Settings VolumeOptions::toSettings() const {
     engine::Settings s;
     s.volume = settings;
     s.volume.skipping = !noSkip;
-    for (const std::string& cl : clips) parseClip(cl, s.volume);
+    for (const std::string& cl : clips) engine::applyClipText(cl, s.volume, "--clip");
     // --tf is read before the volume so that a bad file fails fast; without it the
     // engine chooses the default from the data.
     if (!tf.empty()) s.volume.tf = resolveTransferFunction(tf);
