@@ -10,6 +10,7 @@ RTFACT_PACKAGES=(
   libtbb-dev libopenimageio-dev openimageio-tools
   libpcl-dev libvtk9-dev libopenvdb-dev libembree-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+  libopenmpi-dev openmpi-bin
 )
 
 rtfact_install_packages() {
