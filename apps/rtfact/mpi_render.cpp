@@ -169,6 +169,7 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
             MPI_Recv(&request, 1, MPI_INT, status.MPI_SOURCE, kRequestTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
             mine.bytes += sizeof request;
             if (request == kFailed) {
+                next.store(tiles);  // the frame is lost: the others stop early
                 --waiting;
                 continue;
             }
