@@ -165,6 +165,7 @@ PassResult RenderSession::renderSamples(int n) {
     ro.spp = n;
     ro.progress = opts_.progress;
     ro.cancel = &cancel_;
+    ro.nextTile = opts_.nextTile;
     const int packet = opts_.packet > 0 ? opts_.packet : defaultPacketSize(data.kind);
     PassResult res;
     res.render = renderable_->render(camera, *first_, ro, packet);

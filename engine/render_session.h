@@ -29,6 +29,9 @@ struct FrameOptions {
     bool progress = false;  // progress bar on stderr
     // Named in the error when the framebuffer does not fit in memory (e.g. the output file).
     std::string target = "render";
+    // Renders only the tiles this source hands out (RenderOptions::nextTile; the other
+    // pixels stay empty): the MPI image-parallel mode's ranks share one image this way.
+    std::function<int()> nextTile;
 };
 
 // Rays per packet that measured best for each kind (sub-pixel splats make wide point

@@ -12,6 +12,7 @@ RTFACT_PACKAGES=(
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   pybind11-dev python3-dev python3-numpy python3-pytest
   libboost-dev libturbojpeg0-dev chromium chromium-driver python3-selenium
+  libopenmpi-dev openmpi-bin
 )
 
 rtfact_install_packages() {

@@ -20,6 +20,8 @@ struct CommonOptions {
     int spp = 1;
     bool quiet = false;
     bool stats = false;
+    // Under mpirun: how the ranks share the work ("" or "image": image-parallel; docs/mpi.md).
+    std::string distribute;
 
     // Filled by finalize().
     int width = 1024, height = 1024;

@@ -3,31 +3,42 @@
 #include <cstdio>
 
 #include "core/render/image_io.h"
-#include "engine/render_session.h"
+#ifdef RTFACT_MPI
+#include "apps/rtfact/mpi_render.h"
+#endif
 
 namespace rtfact::app {
 
+RenderJob prepareRender(CommonOptions& c, const std::function<engine::Settings()>& settings,
+                        const std::function<engine::Scene()>& open, bool writer) {
+    c.finalize();
+    RenderJob job;
+    job.settings = settings();
+    if (writer) checkImageWritable(c.out);
+    job.scene = open();
+    if (writer && !c.quiet)
+        for (const std::string& w : job.scene.warnings()) std::fprintf(stderr, "rtfact: warning: %s\n", w.c_str());
+    job.stats = job.scene.loadStats();
+    const engine::DefaultView view = job.scene.defaultView(job.settings);
+    job.camera = c.frame(view.focus, view.viewDir, view.up);
+    job.frame.width = c.width;
+    job.frame.height = c.height;
+    job.frame.packet = c.packet;
+    job.frame.threads = c.threads;
+    job.frame.progress = !c.quiet;
+    job.frame.target = c.out;
+    return job;
+}
+
 int runRenderCommand(CommonOptions& c, const std::function<engine::Settings()>& settings,
                      const std::function<engine::Scene()>& open) {
-    c.finalize();
-    const engine::Settings s = settings();
-    checkImageWritable(c.out);
-    const engine::Scene scene = open();
-    if (!c.quiet)
-        for (const std::string& w : scene.warnings()) std::fprintf(stderr, "rtfact: warning: %s\n", w.c_str());
-    engine::Stats stats = scene.loadStats();
-    const engine::DefaultView view = scene.defaultView(s);
-    const CameraFrame frame = c.frame(view.focus, view.viewDir, view.up);
-    engine::FrameOptions fo;
-    fo.width = c.width;
-    fo.height = c.height;
-    fo.packet = c.packet;
-    fo.threads = c.threads;
-    fo.progress = !c.quiet;
-    fo.target = c.out;
-    const engine::Frame image = engine::renderToImage(scene, s, fo, frame, c.spp, stats);
+#ifdef RTFACT_MPI
+    if (mpiLaunched()) return runMpiRender(c, settings, open);
+#endif
+    RenderJob job = prepareRender(c, settings, open, true);
+    const engine::Frame image = engine::renderToImage(job.scene, job.settings, job.frame, job.camera, c.spp, job.stats);
     writeImage(c.out, image.width, image.height, image.rgba);
-    if (c.stats) stats.print();
+    if (c.stats) job.stats.print();
     return 0;
 }
 

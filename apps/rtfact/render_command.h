@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "apps/rtfact/common_options.h"
+#include "engine/render_session.h"
 #include "engine/scene.h"
 #include "engine/settings.h"
 
@@ -13,5 +14,18 @@ namespace rtfact::app {
 // `settings` runs before any input is read (option errors first); `open` loads the scene.
 int runRenderCommand(CommonOptions& c, const std::function<engine::Settings()>& settings,
                      const std::function<engine::Scene()>& open);
+
+// The skeleton up to the render: settings, scene (with its load statistics), camera and
+// frame options. `writer`: this process writes the image (checks the output first, prints
+// the scene's warnings); under MPI only rank 0 is.
+struct RenderJob {
+    engine::Settings settings;
+    engine::Scene scene;
+    engine::Stats stats;
+    CameraFrame camera;
+    engine::FrameOptions frame;
+};
+RenderJob prepareRender(CommonOptions& c, const std::function<engine::Settings()>& settings,
+                        const std::function<engine::Scene()>& open, bool writer);
 
 }  // namespace rtfact::app

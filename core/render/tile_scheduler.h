@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <functional>
@@ -29,6 +30,27 @@ struct RenderOptions {
     const std::atomic<bool>* cancel = nullptr;
     // Called after each tile with (tiles done, tiles in all samples), from worker threads.
     std::function<void(uint64_t, uint64_t)> onTile;
+    // When set, only the tiles this source hands out are rendered: it returns the next
+    // tile index (row-major over tileSize tiles, see TileGrid) or -1 when there are no
+    // more; called from worker threads. Each tile gets all its samples in order, so its
+    // pixels accumulate exactly as in a whole-image render (the MPI image-parallel mode).
+    std::function<int()> nextTile;
+};
+
+// The tiles of a w x h image, row-major.
+struct TileGrid {
+    int width, height, size, columns, rows;
+    TileGrid(int w, int h, int tileSize)
+        : width(w),
+          height(h),
+          size(std::max(tileSize, 1)),
+          columns((w + size - 1) / size),
+          rows((h + size - 1) / size) {}
+    int count() const { return columns * rows; }
+    Region region(int t) const {
+        const int x0 = (t % columns) * size, y0 = (t / columns) * size;
+        return {x0, y0, std::min(x0 + size, width), std::min(y0 + size, height)};
+    }
 };
 
 struct RenderStats {
@@ -44,9 +66,8 @@ inline int resolveThreads(int requested) { return requested > 0 ? requested : tb
 template <int N, class R, class Scene, class Cam, class FB>
 requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, const Scene& scene, const Cam& cam,
                                                              FB& fb, const RenderOptions& opt) {
-    const int w = fb.width(), h = fb.height();
-    const int ts = std::max(opt.tileSize, 1);
-    const int tx = (w + ts - 1) / ts, ty = (h + ts - 1) / ts, tiles = tx * ty;
+    const TileGrid grid(fb.width(), fb.height(), opt.tileSize);
+    const int tiles = grid.count();
     const int spp = std::max(opt.spp, 1);
     RenderStats st;
     st.threads = resolveThreads(opt.threads);
@@ -58,6 +79,26 @@ requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, 
     const auto t0 = std::chrono::steady_clock::now();
     tbb::task_arena arena(st.threads);
     arena.execute([&] {
+        if (opt.nextTile) {
+            // One task per thread, each pulling tiles until the source runs dry.
+            tbb::parallel_for(
+                0, st.threads,
+                [&](int) {
+                    const RenderCounters before = tlsCounters;
+                    for (int t = 0; !cancelled() && (t = opt.nextTile()) >= 0;) {
+                        if (t >= tiles) continue;
+                        for (int s = opt.firstSample; s < opt.firstSample + spp; ++s) {
+                            renderer.template render<N>(scene, cam, fb, grid.region(t), s);
+                            progress.add();
+                            const uint64_t d = ++done;
+                            if (opt.onTile) opt.onTile(d, total);
+                        }
+                    }
+                    counted.local() += tlsCounters - before;
+                },
+                tbb::simple_partitioner());
+            return;
+        }
         for (int s = opt.firstSample; s < opt.firstSample + spp && !cancelled(); ++s) {
             tbb::parallel_for(
                 tbb::blocked_range<int>(0, tiles, 1),
@@ -65,9 +106,7 @@ requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, 
                     const RenderCounters before = tlsCounters;
                     for (int t = range.begin(); t != range.end(); ++t) {
                         if (cancelled()) break;
-                        const int x0 = (t % tx) * ts, y0 = (t / tx) * ts;
-                        const Region region{x0, y0, std::min(x0 + ts, w), std::min(y0 + ts, h)};
-                        renderer.template render<N>(scene, cam, fb, region, s);
+                        renderer.template render<N>(scene, cam, fb, grid.region(t), s);
                         progress.add();
                         const uint64_t d = ++done;
                         if (opt.onTile) opt.onTile(d, total);
