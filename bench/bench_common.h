@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <chrono>
+#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -27,6 +28,14 @@ inline Vec3f parseVec(const std::string& s, const char* opt) {
     if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',')
         throw Error("", std::string(opt) + ": expected x,y,z, got '" + s + "'");
     return v;
+}
+
+// The CPU's model name, printed next to every figure.
+inline std::string cpuModel() {
+    std::ifstream in("/proc/cpuinfo");
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    return "unknown CPU";
 }
 
 inline constexpr int kTile = 32;

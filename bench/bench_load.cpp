@@ -22,13 +22,6 @@ namespace rtfact::bench {
 
 namespace {
 
-std::string cpuName() {
-    std::ifstream in("/proc/cpuinfo");
-    for (std::string line; std::getline(in, line);)
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
-
 // A LAS file of `copies` times the records of `file` (same header and VLRs, counts
 // patched, EVLRs left out) in the temp directory: a tile large enough to measure.
 std::string replicate(const std::string& file, int copies) {
@@ -93,7 +86,7 @@ int benchLoad(int argc, char** argv) {
         throw Error("--size", "expected WxH, got '" + size + "'");
     const bool laz =
         file.size() > 4 && (file.substr(file.size() - 4) == ".laz" || file.substr(file.size() - 4) == ".LAZ");
-    std::printf("cpu: %s (%u hardware threads)\n", cpuName().c_str(), std::thread::hardware_concurrency());
+    std::printf("cpu: %s (%u hardware threads)\n", cpuModel().c_str(), std::thread::hardware_concurrency());
 
     // Load: points/s against the target of the issue (LAS 50M/s on 2 threads; LAZ 4M/s per thread).
     // Small LAS files are replicated into a tile of 10M points: the figure is then the

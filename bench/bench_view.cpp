@@ -22,13 +22,6 @@ namespace rtfact::bench {
 
 namespace {
 
-std::string cpuModel() {
-    std::ifstream in("/proc/cpuinfo");
-    for (std::string line; std::getline(in, line);)
-        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-    return "unknown CPU";
-}
-
 std::string loadAverage() {
     std::ifstream in("/proc/loadavg");
     std::string a;

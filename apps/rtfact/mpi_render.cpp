@@ -120,6 +120,15 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
     if (int st = mpi.agree(attempt([&] { job = prepareRender(c, settings, open, root); }))) return st;
     if (root && !c.quiet)
         std::fprintf(stderr, "rtfact: mpi: %d ranks, --distribute image (every rank holds the scene)\n", mpi.size);
+    // Eye-dome lighting filters the whole depth image, which no rank holds: rendered
+    // without it (the same on every rank) until the depth is gathered too.
+    if (job.scene.kind() == engine::SceneKind::Points &&
+        (job.settings.points.edl ? *job.settings.points.edl > 0 : job.scene.info().get("normals") == "none")) {
+        if (root && !c.quiet)
+            std::fprintf(stderr,
+                         "rtfact: warning: eye-dome lighting is not applied under mpirun yet: rendering without it\n");
+        job.settings.points.edl = 0.0f;
+    }
 
     const TileGrid grid(c.width, c.height, RenderOptions{}.tileSize);
     const int tiles = grid.count();
