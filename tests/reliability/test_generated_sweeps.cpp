@@ -22,6 +22,7 @@
 #include "surfaces/mesh_loader.h"
 #include "surfaces/mesh_scene.h"
 #include "sweep.h"
+#include "tests/common/deflate_bytes.h"
 #include "volume/volume_io.h"
 
 using namespace rtfact;
@@ -44,19 +45,7 @@ void putLE(std::string& s, T v) {
     s.append(reinterpret_cast<const char*>(&v), sizeof(T));  // x86-64: little endian
 }
 
-std::string gzip(const std::string& raw) {
-    z_stream z{};
-    EXPECT_EQ(deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY), Z_OK);
-    std::string out(deflateBound(&z, uLong(raw.size())) + 64, '\0');
-    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(raw.data()));
-    z.avail_in = uInt(raw.size());
-    z.next_out = reinterpret_cast<Bytef*>(out.data());
-    z.avail_out = uInt(out.size());
-    EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
-    out.resize(z.total_out);
-    deflateEnd(&z);
-    return out;
-}
+std::string gzip(const std::string& raw) { return test::deflateBytes(raw, 15 + 16); }
 
 // LZF with literal runs only: a control byte c < 32 followed by c + 1 literal bytes.
 std::string lzfLiterals(const std::string& raw) {
