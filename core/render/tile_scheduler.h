@@ -77,6 +77,13 @@ requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, 
     tbb::enumerable_thread_specific<RenderCounters> counted;
     Progress progress(opt.label, uint64_t(tiles) * uint64_t(spp), opt.progress);
     const auto t0 = std::chrono::steady_clock::now();
+    // One tile with every sample of this frame (the nextTile source) or one sample.
+    auto renderTile = [&](int t, int s) {
+        renderer.template render<N>(scene, cam, fb, grid.region(t), s);
+        progress.add();
+        const uint64_t d = ++done;
+        if (opt.onTile) opt.onTile(d, total);
+    };
     tbb::task_arena arena(st.threads);
     arena.execute([&] {
         if (opt.nextTile) {
@@ -87,12 +94,7 @@ requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, 
                     const RenderCounters before = tlsCounters;
                     for (int t = 0; !cancelled() && (t = opt.nextTile()) >= 0;) {
                         if (t >= tiles) continue;
-                        for (int s = opt.firstSample; s < opt.firstSample + spp; ++s) {
-                            renderer.template render<N>(scene, cam, fb, grid.region(t), s);
-                            progress.add();
-                            const uint64_t d = ++done;
-                            if (opt.onTile) opt.onTile(d, total);
-                        }
+                        for (int s = opt.firstSample; s < opt.firstSample + spp; ++s) renderTile(t, s);
                     }
                     counted.local() += tlsCounters - before;
                 },
@@ -104,13 +106,7 @@ requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, 
                 tbb::blocked_range<int>(0, tiles, 1),
                 [&](const tbb::blocked_range<int>& range) {
                     const RenderCounters before = tlsCounters;
-                    for (int t = range.begin(); t != range.end(); ++t) {
-                        if (cancelled()) break;
-                        renderer.template render<N>(scene, cam, fb, grid.region(t), s);
-                        progress.add();
-                        const uint64_t d = ++done;
-                        if (opt.onTile) opt.onTile(d, total);
-                    }
+                    for (int t = range.begin(); t != range.end() && !cancelled(); ++t) renderTile(t, s);
                     counted.local() += tlsCounters - before;
                 },
                 tbb::simple_partitioner());
