@@ -1,8 +1,11 @@
-// rtfact-bench volume FILE: RTfact's packet DVR against OpenVDB's ray marcher on the same
-// volume, transfer function, view, step size (in voxels) and thread count, in one
-// process. The peer is the primary-ray part of openvdb::tools::VolumeRender: a
-// VolumeRayIntersector (hierarchical DDA over the active tree, `hits` spans) and a
-// BoxSampler (trilinear) per sample, sampling at t = step * k like VolumeRender, with
+// rtfact-bench volume FILE: RTfact's packet DVR against two peers on the same volume,
+// transfer function, view, step size (in voxels) and thread count, in one process:
+// VTK's vtkFixedPointVolumeRayCastMapper (bench_vtk_volume.h; under xvfb-run when there
+// is no DISPLAY) and OpenVDB's ray marcher. Image quality: PSNR of each frame against
+// RTfact at a fine step (--ref-step) with the same transfer function. The OpenVDB peer
+// is the primary-ray part of openvdb::tools::VolumeRender: a VolumeRayIntersector
+// (hierarchical DDA over the active tree, `hits` spans) and a BoxSampler (trilinear) per
+// sample, sampling at t = step * k like VolumeRender, with
 // the same TF lookup table and early termination; no shadow rays on either side. Its
 // grid's active voxels are those the TF makes visible (the information our macrocells
 // get), or the file's own tree for .vdb input.
@@ -22,8 +25,11 @@
 
 #include "bench/bench_commands.h"
 #include "bench/bench_common.h"
+#include "bench/bench_vtk_volume.h"
 #include "core/render/image_io.h"
 #include "core/render/pinhole_camera.h"
+#include "core/render/srgb.h"
+#include "core/simd/native.h"
 #include "core/util/error.h"
 #include "engine/built_scene.h"
 #include "engine/render_session.h"
@@ -101,22 +107,62 @@ openvdb::FloatGrid::Ptr toVdb(const BrickedVolume& v, const TFTable& tf) {
     return grid;
 }
 
+// PSNR of RGB over black against `ref` (peak 1), in linear values: both renderers
+// composite linear colours, and VTK's 8-bit read-back stays exact enough there
+// (quantisation alone caps it at 59 dB).
+double psnr(const std::vector<float>& img, const std::vector<float>& ref) {
+    double se = 0;
+    for (size_t p = 0; p < ref.size(); p += 4)
+        for (size_t c = 0; c < 3; ++c) {
+            const double d = double(std::clamp(img[p + c], 0.0f, 1.0f)) - double(std::clamp(ref[p + c], 0.0f, 1.0f));
+            se += d * d;
+        }
+    const double mse = se / (double(ref.size() / 4) * 3.0);
+    return mse <= 0 ? 99.0 : -10.0 * std::log10(mse);
+}
+
+// The same in 8-bit sRGB (what the tests' image metric and the PNG files use).
+double psnrSrgb8(const std::vector<float>& img, const std::vector<float>& ref) {
+    double se = 0;
+    for (size_t p = 0; p < ref.size(); p += 4)
+        for (size_t c = 0; c < 3; ++c) {
+            const double d = double(linearToSrgb8(img[p + c])) - double(linearToSrgb8(ref[p + c]));
+            se += d * d;
+        }
+    const double mse = se / (double(ref.size() / 4) * 3.0);
+    return mse <= 0 ? 99.0 : 10.0 * std::log10(255.0 * 255.0 / mse);
+}
+
+double nonBlackFraction(const std::vector<float>& img) {
+    size_t n = 0;
+    for (size_t p = 0; p < img.size(); p += 4) n += img[p] > 0 || img[p + 1] > 0 || img[p + 2] > 0;
+    return double(n) / double(img.size() / 4);
+}
+
 }  // namespace
 
 int benchVolume(int argc, char** argv) {
-    CLI::App app{"rtfact-bench volume: RTfact DVR vs OpenVDB's ray marcher (VolumeRayIntersector + BoxSampler)"};
-    std::string file, dims, type, tfName = "ct-bone", size = "1024x1024", eye, at, up, outPrefix;
-    float step = 0.5f, fov = 45.0f;
+    CLI::App app{
+        "rtfact-bench volume: RTfact DVR vs VTK's vtkFixedPointVolumeRayCastMapper and OpenVDB's ray marcher "
+        "(VolumeRayIntersector + BoxSampler)"};
+    std::string file, dims, type, tfName = "ct-bone", size = "1024x1024", eye, at, up, outPrefix, mode = "dvr";
+    float step = 0.5f, fov = 45.0f, refStep = 0.1f;
     int threads = 0, frames = 3, packet = 16;
     std::optional<float> window, level;
-    bool skipPeer = false;
+    bool skipPeer = false, skipVtk = false;
     app.add_option("FILE", file, "Volume file")->required();
     app.add_option("--dims", dims, "Raw dims X,Y,Z");
     app.add_option("--type", type, "Raw type u8|u16|i16|f32");
     app.add_option("--tf", tfName, "Transfer function preset or .json")->capture_default_str();
     app.add_option("--window", window, "Window width");
     app.add_option("--level", level, "Window level");
-    app.add_option("--step", step, "Step in voxels")->capture_default_str();
+    app.add_option("--step", step, "Step in voxels")->capture_default_str()->check(CLI::PositiveNumber);
+    app.add_option("--mode", mode, "dvr, or shaded (VTK shades too; OpenVDB is left out)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"dvr", "shaded"}));
+    app.add_option("--ref-step", refStep, "Step of the RTfact reference for PSNR (0: no reference)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--size", size, "Image WxH")->capture_default_str();
     app.add_option("--eye", eye, "Camera eye x,y,z");
     app.add_option("--at", at, "Camera target x,y,z");
@@ -126,13 +172,20 @@ int benchVolume(int argc, char** argv) {
         ->capture_default_str();
     app.add_option("--frames", frames, "Frames per measurement (best is reported)")->capture_default_str();
     app.add_option("--packet", packet, "RTfact packet size")->capture_default_str();
-    app.add_option("--images", outPrefix, "Write PREFIX_rtfact.png and PREFIX_openvdb.png");
-    app.add_flag("--no-peer", skipPeer, "Only RTfact");
+    app.add_option(
+        "--images", outPrefix,
+        "Write PREFIX_rtfact.png, PREFIX_vtk.png (and _vtk_cast.png), PREFIX_openvdb.png and PREFIX_reference.png");
+    app.add_flag("--no-peer", skipPeer, "Only RTfact (no VTK, no OpenVDB)");
+    app.add_flag("--no-vtk", skipVtk, "Leave out the VTK peer (it needs an X server: xvfb-run)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
+    const bool runVtk = !skipPeer && !skipVtk, runVdb = !skipPeer && mode == "dvr";
+    // VTK's render window needs X: without DISPLAY, this run continues under xvfb-run.
+    if (runVtk) requireDisplayOrReexec(argc, argv);
+    if (!outPrefix.empty()) checkImageWritable(outPrefix + "_rtfact.png");  // fail before rendering
     int w = 0, h = 0;
     if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) throw Error("--size", "expected WxH");
     // Loading, the default view, the TF and window and the volume scene are the engine's,
@@ -163,6 +216,7 @@ int benchVolume(int argc, char** argv) {
     settings.volume.window = window;
     settings.volume.level = level;
     settings.volume.step = step;
+    settings.volume.mode = mode;
     t0 = Clock::now();
     const engine::BuiltVolume built = engine::builtVolume(sc, settings);
     const double buildMs = msSince(t0);
@@ -178,8 +232,12 @@ int benchVolume(int argc, char** argv) {
     std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, TF %.0f ms\n",
                 file.c_str(), vol.dims[0], vol.dims[1], vol.dims[2], storageName(vol.storage), vol.sourceType.c_str(),
                 vol.storedBricks(), vol.brickCount(), double(vol.memoryBytes()) / 1048576.0, loadMs, buildMs);
-    std::printf("view %dx%d, tf %s window [%g, %g], step %g voxels, packet %d, frames %d (best reported)\n", w, h,
-                built.setup.tf.name.c_str(), double(win.first), double(win.second), double(step), packet, frames);
+    std::printf("view %dx%d, %s, tf %s window [%g, %g], step %g voxels, packet %d, frames %d (best reported)\n", w, h,
+                mode.c_str(), built.setup.tf.name.c_str(), double(win.first), double(win.second), double(step), packet,
+                frames);
+    std::printf("cpu: %s, isa %s\n", cpuModel().c_str(), simd::isaName());
+    if (!skipPeer && !runVdb)
+        std::printf("note: the OpenVDB peer does not shade; left out in --mode %s\n", mode.c_str());
 
     struct Result {
         double ms = 0;
@@ -226,7 +284,7 @@ int benchVolume(int argc, char** argv) {
         return best;
     };
 
-    if (!skipPeer) {
+    if (runVdb) {
         t0 = Clock::now();
         if (isVdb) {
             // The file's own sparse tree (values in data units = stored units here).
@@ -257,30 +315,101 @@ int benchVolume(int argc, char** argv) {
         std::printf("openvdb grid: %llu active voxels, built in %.0f ms\n",
                     (unsigned long long)peer.grid->activeVoxelCount(), msSince(t0));
     }
+    std::unique_ptr<VtkVolumePeer> vtk;
+    if (runVtk) {
+        t0 = Clock::now();
+        VtkVolumeView view;
+        view.volume = &vol;
+        view.tf = built.setup.tf;
+        view.window = {table.lo, table.hi};
+        view.stepVoxels = step;
+        view.shaded = mode == "shaded";
+        view.camera = frame;
+        view.width = w;
+        view.height = h;
+        vtk = std::make_unique<VtkVolumePeer>(view);
+        std::printf(
+            "vtk: vtkFixedPointVolumeRayCastMapper (VTK 9.1), sample distance %g world units, set up in %.0f ms; "
+            "vtk ms = its ray cast, Render() = the whole window render\n",
+            double(step * minComponent(vol.spacing)), msSince(t0));
+    }
 
     std::printf("%-8s %7s %10s %9s %11s %12s\n", "who", "threads", "ms/frame", "Mrays/s", "Msamples/s", "samples");
     const double rays = double(w) * double(h);
+    std::string summary;
+    char line[256];
     for (int th : {1, allThreads}) {
         const Result ours = runOurs(th);
         std::printf("%-8s %7d %10.1f %9.2f %11.1f %12llu\n", "rtfact", th, ours.ms, rays / (ours.ms * 1e3),
                     double(ours.samples) / (ours.ms * 1e3), (unsigned long long)ours.samples);
-        if (!skipPeer) {
+        std::snprintf(line, sizeof line, "threads=%d rtfact_ms=%.1f", th, ours.ms);
+        summary += line;
+        if (vtk) {
+            const VtkVolumePeer::Timing t = vtk->render(th, frames);
+            std::printf("%-8s %7d %10.1f %9.2f %11s %12s  Render() %.1f ms\n", "vtk", th, t.castMs,
+                        rays / (t.castMs * 1e3), "-", "-", t.renderMs);
+            std::printf("ratio    %7d %10.2fx (vtk ms / rtfact ms)\n", th, t.castMs / ours.ms);
+            std::snprintf(line, sizeof line, " vtk_ms=%.1f vtk/rtfact=%.2fx", t.castMs, t.castMs / ours.ms);
+            summary += line;
+        }
+        if (runVdb) {
             const Result theirs = runPeer(th);
             std::printf("%-8s %7d %10.1f %9.2f %11.1f %12llu\n", "openvdb", th, theirs.ms, rays / (theirs.ms * 1e3),
                         double(theirs.samples) / (theirs.ms * 1e3), (unsigned long long)theirs.samples);
             std::printf("ratio    %7d %10.2fx (openvdb ms / rtfact ms)\n", th, theirs.ms / ours.ms);
+            std::snprintf(line, sizeof line, " openvdb_ms=%.1f openvdb/rtfact=%.2fx", theirs.ms, theirs.ms / ours.ms);
+            summary += line;
         }
+        summary += "\n";
         if (th == allThreads) break;
     }
-    if (!skipPeer) {
+    std::printf("summary (%s, %s):\n%s", cpuModel().c_str(), simd::isaName(), summary.c_str());
+    if (runVdb) {
         double diff = 0;
         for (size_t i = 0; i < ourImage.size(); ++i) diff += std::fabs(ourImage[i] - peerImage[i]);
         std::printf("mean |rtfact - openvdb| per channel: %.4f (same view and TF; sample positions differ)\n",
                     diff / double(ourImage.size()));
     }
+    std::vector<float> vtkImage, vtkCast, refImage;
+    if (vtk) {
+        vtkCast = vtk->castImage();
+        vtkImage = vtk->image();
+    }
+    if (refStep > 0) {
+        // The fine-step reference: RTfact, same TF (its opacity corrected for the finer step).
+        engine::Settings refSettings = settings;
+        refSettings.volume.step = refStep;
+        engine::FrameOptions fo;
+        fo.width = w;
+        fo.height = h;
+        fo.packet = packet;
+        fo.threads = allThreads;
+        t0 = Clock::now();
+        engine::RenderSession session(sc, refSettings, fo, frame);
+        session.renderPass();
+        refImage = session.frame().rgba;
+        std::printf(
+            "quality: PSNR of RGB over black (linear, peak 1; 8-bit sRGB in brackets) against RTfact at step %g "
+            "voxels (%.0f ms)%s:\n",
+            double(refStep), msSince(t0),
+            vtk ? "; vtk = its window read back (vtkWindowToImageFilter), vtk_cast = the mapper's own image" : "");
+        std::printf("psnr_rtfact_db=%.2f [%.2f]", psnr(ourImage, refImage), psnrSrgb8(ourImage, refImage));
+        if (vtk)
+            std::printf(" psnr_vtk_db=%.2f [%.2f] psnr_vtk_cast_db=%.2f [%.2f]", psnr(vtkImage, refImage),
+                        psnrSrgb8(vtkImage, refImage), psnr(vtkCast, refImage), psnrSrgb8(vtkCast, refImage));
+        if (runVdb)
+            std::printf(" psnr_openvdb_db=%.2f [%.2f]", psnr(peerImage, refImage), psnrSrgb8(peerImage, refImage));
+        std::printf("\n");
+    }
+    if (vtk)
+        std::printf("vtk_nonblack=%.3f rtfact_nonblack=%.3f (fraction of pixels not black)\n",
+                    nonBlackFraction(vtkImage), nonBlackFraction(ourImage));
     if (!outPrefix.empty()) {
         writeImage(outPrefix + "_rtfact.png", w, h, ourImage);
-        if (!skipPeer) writeImage(outPrefix + "_openvdb.png", w, h, peerImage);
+        if (runVdb) writeImage(outPrefix + "_openvdb.png", w, h, peerImage);
+        if (vtk) writeImage(outPrefix + "_vtk.png", w, h, vtkImage);
+        if (vtk) writeImage(outPrefix + "_vtk_cast.png", w, h, vtkCast);
+        if (!refImage.empty()) writeImage(outPrefix + "_reference.png", w, h, refImage);
     }
     return 0;
 }

@@ -13,6 +13,7 @@ RTFACT_PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest
   libboost-dev libturbojpeg0-dev chromium chromium-driver python3-selenium
   libopenmpi-dev openmpi-bin
+  xvfb xauth libx11-dev
 )
 
 rtfact_install_packages() {
