@@ -229,6 +229,53 @@ TEST(LoDTree, RepresentativeDiscsCoverTheirSubtrees) {
 
 namespace {
 
+// Every inner node splits its discs at the median along its axis: the left subtree holds
+// n/2 discs, none right of the split plane; the right subtree none left of it.
+void checkMedianSplits(const std::vector<Disc>& input, int leafSize) {
+    LoDKdTreeBuilder b;
+    b.maxLeafSize = leafSize;
+    const LoDKdTree t = b.build(input);
+    ASSERT_EQ(t.elems.size(), input.size());
+    std::vector<int> seen(t.elems.size(), 0);
+    struct Range {
+        uint32_t first, count;
+    };
+    std::function<Range(uint32_t)> walk = [&](uint32_t node) -> Range {
+        const KdNode& n = t.nodes[node];
+        if (n.isLeaf()) {
+            EXPECT_LE(n.count, uint32_t(leafSize));
+            for (uint32_t i = 0; i < n.count; ++i) ++seen[n.first() + i];
+            return {n.first(), n.count};
+        }
+        const Range a = walk(n.left()), c = walk(n.left() + 1);
+        EXPECT_EQ(a.count, (a.count + c.count) / 2) << "node " << node;
+        for (uint32_t i = a.first; i < a.first + a.count; ++i) EXPECT_LE(t.elems[i].center[n.axis()], n.split);
+        for (uint32_t i = c.first; i < c.first + c.count; ++i) EXPECT_GE(t.elems[i].center[n.axis()], n.split);
+        return {a.first, a.count + c.count};
+    };
+    const Range all = walk(0);
+    EXPECT_EQ(all.count, input.size());
+    for (int s : seen) ASSERT_EQ(s, 1);
+}
+
+}  // namespace
+
+TEST(LoDTree, SplitsAtTheMedianWithDistinctAndTiedCoordinates) {
+    // Above 65536 discs the builder's own selection runs, below it std::nth_element.
+    checkMedianSplits(randomDiscs(150000, 41), 8);
+    checkMedianSplits(randomDiscs(777, 42), 1);
+    // Coordinates on a coarse lattice: long runs of equal keys in every selection.
+    std::vector<Disc> tied = randomDiscs(150000, 43);
+    for (Disc& d : tied) d.center = Vec3f(std::round(d.center.x * 2), std::round(d.center.y * 2), d.center.z);
+    checkMedianSplits(tied, 8);
+    // All on one point: no split separates anything.
+    std::vector<Disc> same = randomDiscs(500, 44);
+    for (Disc& d : same) d.center = Vec3f(0.25f, 0.5f, 0.75f);
+    checkMedianSplits(same, 4);
+}
+
+namespace {
+
 struct RepHitStats {
     int repHits = 0;
     int sameSubtree = 0;  // full detail hits a disc of the representative's subtree
