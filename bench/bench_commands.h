@@ -10,5 +10,7 @@ int benchPython(int argc, char** argv);
 // The browser viewer over a socket (bench_view.cpp).
 int benchView(int argc, char** argv);
 int benchLoad(int argc, char** argv);
+// Under mpirun: compositing and data-parallel scaling (bench_mpi.cpp; RTFACT_MPI builds).
+int benchMpi(int argc, char** argv);
 
 }  // namespace rtfact::bench

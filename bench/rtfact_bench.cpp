@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
         if (!std::strcmp(argv[1], "python")) return benchPython(argc - 1, argv + 1);
         if (!std::strcmp(argv[1], "view")) return benchView(argc - 1, argv + 1);
         if (!std::strcmp(argv[1], "load")) return benchLoad(argc - 1, argv + 1);
+#ifdef RTFACT_BENCH_MPI
+        if (!std::strcmp(argv[1], "mpi")) return benchMpi(argc - 1, argv + 1);
+#endif
     } catch (const rtfact::Error& e) {
         std::fprintf(stderr, "rtfact-bench: error: %s\n", e.message().c_str());
         return 1;

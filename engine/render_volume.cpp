@@ -60,6 +60,11 @@ VolumeSetup resolveVolumeSetup(const BrickedVolume& vol, const VolumeSettings& s
     rs.skipping = s.skipping;
     rs.clipLo = s.clipLo;
     rs.clipHi = s.clipHi;
+    if (s.lattice) {
+        rs.lattice = true;
+        rs.latticeLo = s.lattice->lo;
+        rs.latticeHi = s.lattice->hi;
+    }
     const auto [lo, hi] = vol.valueRange();
     TransferFunction tf;
     std::pair<float, float> window;

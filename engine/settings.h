@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/math/aabb.h"
 #include "core/math/vec3f.h"
 #include "points/point_prepare.h"
 #include "surfaces/mesh.h"
@@ -58,6 +59,8 @@ struct VolumeSettings {
     float step = 0.5f;                           // voxels
     Vec3f clipLo{0, 0, 0}, clipHi{1, 1, 1};      // fractions of each axis
     bool skipping = true;
+    // Data-parallel ranks: samples on the lattice of this world box (docs/mpi.md).
+    std::optional<AABB> lattice;
 };
 
 struct SpheresSettings {

@@ -127,7 +127,19 @@ struct VolumeIntegrator {
         // Sample k sits at tNear + (k + 1/2) dt, computed directly (not accumulated) so
         // that skipping and stepping reach bit-identical positions.
         P kf(0.0f);
-        P t = tNear + P(0.5f) * dt;
+        if (s.settings.lattice) {
+            // A data-parallel rank: the first lattice point (of the whole volume's box)
+            // inside this rank's box; tNear then stands for the lattice's start.
+            P tL = tMin;
+            for (int a = 0; a < 3; ++a) {
+                const P lo((s.settings.latticeLo[a] - s.origin[a]) * s.invSpacing[a]);
+                const P hi((s.settings.latticeHi[a] - s.origin[a]) * s.invSpacing[a]);
+                tL = max(tL, min((lo - oi[a]) * inv[a], (hi - oi[a]) * inv[a]));
+            }
+            kf = max(P(0.0f), -floor(-((tNear - tL) * invDt - P(0.5f))));
+            tNear = tL;
+        }
+        P t = tNear + (kf + P(0.5f)) * dt;
         Mask<W> alive = act & (tNear <= tFar) & (t < tFar);
         col = Vec3<W>(Vec3f(0.0f));
         alpha = P(0.0f);

@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -22,6 +23,10 @@ struct VolumeLoadOptions {
     uint64_t headerSkip = 0;
     std::string grid;  // OpenVDB grid name; default the first float grid
     bool progress = true;
+    // Data-parallel ranks (docs/mpi.md): given the file's dims, the slices [z0, z1) to
+    // read; the grid then holds only those (origin unchanged). Raw, MetaImage, NRRD and
+    // NIfTI read just their bytes (loadVolumeSlices covers the other formats).
+    std::function<std::array<int, 2>(const std::array<int, 3>& dims)> slices;
 };
 
 // True for paths this module claims (by extension, or a directory of DICOM files).

@@ -74,14 +74,20 @@ Storage storageFor(ScalarType s) {
 
 // Reads the pieces and converts the source type into the grid's compact storage.
 void decodePayload(VolumeGrid& g, ScalarType src, bool bigEndian, std::vector<Piece>& pieces, const std::string& header,
-                   bool progress) {
-    const uint64_t n = g.voxelCount();
+                   const VolumeLoadOptions& o) {
+    const bool progress = o.progress;
+    uint64_t n = g.voxelCount();
     const int sb = io::scalarBytes(src);
     uint64_t total = 0;
     for (const Piece& p : pieces) total += p.bytes;
     if (total != n * uint64_t(sb))
         throw Error(header, "data pieces hold " + std::to_string(total) + " bytes, expected " +
                                 std::to_string(n * uint64_t(sb)));
+    if (o.slices) {  // a data-parallel rank's slab (docs/mpi.md)
+        keepSlices(g, sb, pieces, header, o.slices({g.dims[0], g.dims[1], g.dims[2]}));
+        n = g.voxelCount();
+        total = n * uint64_t(sb);
+    }
     checkPieces(header, pieces);
     g.sourceType = io::scalarTypeName(src);
     // The dense grid plus its bricked copy for rendering.

@@ -33,8 +33,13 @@ struct Piece {
 
 // Checks the pieces against their files and the memory budget, reads them and converts
 // the source type into the grid's compact storage.
+// With o.slices, only those slices' bytes are read (keepSlices).
 void decodePayload(VolumeGrid& g, io::ScalarType src, bool bigEndian, std::vector<Piece>& pieces,
-                   const std::string& header, bool progress);
+                   const std::string& header, const VolumeLoadOptions& o);
+// Trims the pieces to the bytes of slices [z0, z1) of g (volume_io_region.cpp) and sets
+// g.dims[2] to their count.
+void keepSlices(VolumeGrid& g, int sourceBytes, std::vector<Piece>& pieces, const std::string& header,
+                std::array<int, 2> z);
 // A voxel type as MetaImage, NRRD or our options spell it ("MET_USHORT", "unsigned short", "u16").
 io::ScalarType parseVoxelType(const std::string& file, std::string t);
 

@@ -105,7 +105,7 @@ VolumeGrid loadMetaImage(const std::string& path, const VolumeLoadOptions& o) {
         if (headerSize == -1) p.skipFromEnd = true;
         pieces.push_back(p);
     }
-    decodePayload(g, src, big, pieces, path, o.progress);
+    decodePayload(g, src, big, pieces, path, o);
     return g;
 }
 

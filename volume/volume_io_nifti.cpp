@@ -108,7 +108,7 @@ VolumeGrid loadNifti(const std::string& path, const VolumeLoadOptions& o) {
         pieces.push_back({path, 0, uint64_t(vox), true, bytes});
     else
         pieces.push_back({path, uint64_t(vox), 0, false, bytes});
-    decodePayload(g, src, swap, pieces, path, o.progress);
+    decodePayload(g, src, swap, pieces, path, o);
     return g;
 }
 

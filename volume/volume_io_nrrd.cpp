@@ -202,7 +202,7 @@ VolumeGrid loadNrrd(const std::string& path, const VolumeLoadOptions& o) {
             p.offset += uint64_t(byteSkip);
         pieces.push_back(p);
     }
-    decodePayload(g, src, big, pieces, path, o.progress);
+    decodePayload(g, src, big, pieces, path, o);
     return g;
 }
 

@@ -34,7 +34,7 @@ VolumeGrid loadRaw(const std::string& path, const VolumeLoadOptions& o) {
                         (o.headerSkip ? " after a " + std::to_string(o.headerSkip) + "-byte header" : std::string()) +
                         ", file has " + std::to_string(fsz));
     std::vector<Piece> pieces{{path, o.headerSkip, 0, false, need}};
-    decodePayload(g, src, lower(o.endian) == "big", pieces, path, o.progress);
+    decodePayload(g, src, lower(o.endian) == "big", pieces, path, o);
     return g;
 }
 

@@ -24,6 +24,11 @@ struct VolumeRenderSettings {
     bool skipping = true;                    // empty-space skipping from the macrocells
     Vec3f clipLo{0, 0, 0}, clipHi{1, 1, 1};  // fractions of each axis
     float earlyTermination = 0.99f;
+    // Data-parallel ranks (docs/mpi.md): samples lie on the lattice that starts where the
+    // ray enters this world box (the whole volume's clipped box), not the rank's own box,
+    // so neighbouring slabs meet without seams.
+    bool lattice = false;
+    Vec3f latticeLo, latticeHi;
 };
 
 template <class T>

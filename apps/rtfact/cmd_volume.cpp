@@ -29,9 +29,11 @@ void addVolumeCommand(CLI::App& app, CommandList& list) {
         ->required();
     o->volume.addTo(*cmd);
     list.push_back({cmd, [o] {
+                        const DataSource data{engine::SceneKind::Volume, o->file,
+                                              [&] { return o->volume.openOptions(!o->common.quiet); }};
                         return runRenderCommand(
                             o->common, [&] { return o->volume.toSettings(); },
-                            [&] { return engine::open({o->file}, o->volume.openOptions(!o->common.quiet)); });
+                            [&] { return engine::open({o->file}, o->volume.openOptions(!o->common.quiet)); }, &data);
                     }});
 }
 

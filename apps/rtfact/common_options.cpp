@@ -119,7 +119,9 @@ void CommonOptions::addTo(CLI::App& cmd, const std::string& defaultOut) {
     cmd.add_option("--spp", spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(1, 1 << 20));
     cmd.add_flag("--quiet", quiet, "No progress bars");
     cmd.add_flag("--stats", stats, "Print key=value statistics at the end");
-    cmd.add_option("--distribute", distribute, "Under mpirun: image (every rank loads the scene, tiles are shared)")
+    cmd.add_option("--distribute", distribute,
+                   "Under mpirun: image (every rank loads the scene, tiles are shared) or data (volumes: each "
+                   "rank loads a slab; default: image when the data fits every rank)")
         ->check(CLI::IsMember({"image", "data"}));
 }
 
@@ -133,9 +135,6 @@ void CommonOptions::finalize() {
     if (!ok) throw CLI::ValidationError("--packet", "must be one of " + supportedPacketSizes());
     if (eyeV && atV && length(*eyeV - *atV) == 0.0f) throw CLI::ValidationError("--eye", "eye and --at coincide");
     if (upV && length(*upV) == 0.0f) throw CLI::ValidationError("--up", "must not be zero");
-    if (distribute == "data")
-        throw CLI::ValidationError("--distribute",
-                                   "'data' (data-parallel rendering) is not supported yet; use --distribute image");
     setProgressEnabled(!quiet);
 }
 

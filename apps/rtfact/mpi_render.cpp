@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "apps/rtfact/mpi_common.h"
+#include "apps/rtfact/mpi_data.h"
 #include "apps/rtfact/render_command.h"
 #include "core/render/image_io.h"
 #include "core/util/error.h"
@@ -22,75 +24,14 @@
 
 namespace rtfact::app {
 
+using mpi::attempt;
+using mpi::Mpi;
+using mpi::Outcome;
+
 namespace {
 
 constexpr int kRequestTag = 1, kTileTag = 2;
 constexpr int kWantTile = 0, kFailed = 1;  // what a worker's request says
-
-// What a step ended with on this rank: 0, or the exit status and its message.
-struct Outcome {
-    int status = 0;
-    std::string message;
-};
-
-// Runs `f`, turning its exceptions into the exit status main() would give them.
-template <class F>
-Outcome attempt(F&& f) {
-    Outcome o;
-    try {
-        f();
-    } catch (const CLI::ParseError& e) {
-        o = {2, e.what()};
-    } catch (const engine::UsageError& e) {
-        o = {2, e.message()};
-    } catch (const Error& e) {
-        o = {1, e.message()};
-    } catch (const std::bad_alloc&) {
-        o = {1, "out of memory"};
-    } catch (const std::exception& e) {
-        o = {1, e.what()};
-    }
-    return o;
-}
-
-class Mpi {
-   public:
-    Mpi() {
-        int provided = 0;
-        // Workers' render threads ask for tiles, one at a time (SERIALIZED).
-        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
-        MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-        MPI_Comm_size(MPI_COMM_WORLD, &size);
-        serialized = provided >= MPI_THREAD_SERIALIZED;
-    }
-    ~Mpi() { MPI_Finalize(); }
-    Mpi(const Mpi&) = delete;
-    Mpi& operator=(const Mpi&) = delete;
-
-    // Collective: every rank learns whether any failed; rank 0 prints the first failing
-    // rank's message as the one error line. Returns that rank's exit status (0: none).
-    int agree(const Outcome& mine) const {
-        int failing = mine.status ? rank : size;
-        MPI_Allreduce(MPI_IN_PLACE, &failing, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-        if (failing == size) return 0;
-        int head[2] = {mine.status, int(mine.message.size())};
-        MPI_Bcast(head, 2, MPI_INT, failing, MPI_COMM_WORLD);
-        std::string message = rank == failing ? mine.message : std::string(size_t(head[1]), '\0');
-        MPI_Bcast(message.data(), head[1], MPI_CHAR, failing, MPI_COMM_WORLD);
-        if (rank == 0) std::fprintf(stderr, "rtfact: error: rank %d: %s\n", failing, message.c_str());
-        return head[0];
-    }
-    // For a failure the ranks cannot agree on (out of step): one line, then every rank ends.
-    [[noreturn]] void abort(const Outcome& o) const {
-        std::fprintf(stderr, "rtfact: error: rank %d: %s\n", rank, o.message.c_str());
-        std::fflush(stderr);
-        MPI_Abort(MPI_COMM_WORLD, o.status ? o.status : 1);
-        std::abort();
-    }
-
-    int rank = 0, size = 1;
-    bool serialized = false;
-};
 
 // What each rank reports for --stats.
 struct RankFigures {
@@ -106,12 +47,15 @@ bool mpiLaunched() {
 }
 
 int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& settings,
-                 const std::function<engine::Scene()>& open) {
+                 const std::function<engine::Scene()>& open, const DataSource* data) {
     Mpi mpi;
     const bool root = mpi.rank == 0;
     if (int st =
             mpi.agree(mpi.serialized ? Outcome{} : Outcome{1, "the MPI library does not offer MPI_THREAD_SERIALIZED"}))
         return st;
+    std::string mode;
+    if (int st = mpi.agree(attempt([&] { mode = chooseDistribution(c, data, mpi.size); }))) return st;
+    if (mode == "data") return runMpiData(mpi, c, settings, *data);
 
     // Every rank loads the scene; a rank that cannot (a file only some ranks can read)
     // ends them all.
@@ -119,7 +63,8 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
     RenderJob job;
     if (int st = mpi.agree(attempt([&] { job = prepareRender(c, settings, open, root); }))) return st;
     if (root && !c.quiet)
-        std::fprintf(stderr, "rtfact: mpi: %d ranks, --distribute image (every rank holds the scene)\n", mpi.size);
+        std::fprintf(stderr, "rtfact: mpi: %d ranks, --distribute image (every rank holds the scene)%s\n", mpi.size,
+                     c.distribute.empty() ? ", chosen: the data fits every rank" : "");
     // Eye-dome lighting filters the whole depth image, which no rank holds: rendered
     // without it (the same on every rank) until the depth is gathered too.
     if (job.scene.kind() == engine::SceneKind::Points &&

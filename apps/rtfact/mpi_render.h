@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "apps/rtfact/common_options.h"
+#include "apps/rtfact/render_command.h"
 #include "engine/scene.h"
 #include "engine/settings.h"
 
@@ -16,8 +17,9 @@ namespace rtfact::app {
 // or without mpirun, rtfact renders alone and MPI is never initialised).
 bool mpiLaunched();
 
-// runRenderCommand's MPI counterpart; returns the exit status of this rank.
+// runRenderCommand's MPI counterpart; returns the exit status of this rank. `data`: the
+// command can also render data-parallel (--distribute data).
 int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& settings,
-                 const std::function<engine::Scene()>& open);
+                 const std::function<engine::Scene()>& open, const DataSource* data = nullptr);
 
 }  // namespace rtfact::app

@@ -31,9 +31,11 @@ RenderJob prepareRender(CommonOptions& c, const std::function<engine::Settings()
 }
 
 int runRenderCommand(CommonOptions& c, const std::function<engine::Settings()>& settings,
-                     const std::function<engine::Scene()>& open) {
+                     const std::function<engine::Scene()>& open, const DataSource* data) {
 #ifdef RTFACT_MPI
-    if (mpiLaunched()) return runMpiRender(c, settings, open);
+    if (mpiLaunched()) return runMpiRender(c, settings, open, data);
+#else
+    (void)data;
 #endif
     RenderJob job = prepareRender(c, settings, open, true);
     const engine::Frame image = engine::renderToImage(job.scene, job.settings, job.frame, job.camera, c.spp, job.stats);

@@ -3,6 +3,7 @@
 // engine, fit the camera, render, write the image, print the stats.
 #pragma once
 #include <functional>
+#include <string>
 
 #include "apps/rtfact/common_options.h"
 #include "engine/render_session.h"
@@ -11,9 +12,17 @@
 
 namespace rtfact::app {
 
+// What a command that can render data-parallel under mpirun (docs/mpi.md) reads: each
+// rank then opens only its part of `file`.
+struct DataSource {
+    engine::SceneKind kind = engine::SceneKind::Volume;
+    std::string file;
+    std::function<engine::OpenOptions()> options;
+};
+
 // `settings` runs before any input is read (option errors first); `open` loads the scene.
 int runRenderCommand(CommonOptions& c, const std::function<engine::Settings()>& settings,
-                     const std::function<engine::Scene()>& open);
+                     const std::function<engine::Scene()>& open, const DataSource* data = nullptr);
 
 // The skeleton up to the render: settings, scene (with its load statistics), camera and
 // frame options. `writer`: this process writes the image (checks the output first, prints

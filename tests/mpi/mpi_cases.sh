@@ -1,15 +1,22 @@
 #!/usr/bin/env bash
 # rtfact under mpirun (tests/mpi/CMakeLists.txt sets the OpenMPI environment).
-# usage: mpi_cases.sh identical|failing SCENE RTFACT MPIEXEC DATASETS WORK_DIR
+# usage: mpi_cases.sh identical|failing|data|data_failing SCENE RTFACT MPIEXEC DATASETS WORK_DIR [COMPARE]
 #   identical: the image of 2, 3 and 4 ranks (--distribute image) equals the
 #              single-process image bit for bit (float EXR pixels; the files differ in
 #              their DateTime), and -np 1 too.
 #   failing:   a rank given a file it cannot read (MPMD launch: the other ranks get the
 #              real file) makes every rank exit non-zero with one error line naming the
 #              rank, within the timeout, and no image is written; --distribute data is a
-#              usage error (exit 2).
+#              usage error (exit 2) for anything but volumes.
+#   data:      --distribute data (volumes): 2, 3 and 4 ranks within the regression
+#              tolerance of one process (COMPARE: tests/common/image_compare.h's metric),
+#              with features straddling the slab borders (phantom), no seam in a
+#              homogeneous slab crossing them (every channel within 2/255), and each rank
+#              loading about 1/N of the volume plus ghosts (bytes read and VmHWM).
+#   data_failing: a volume file cut short so that only the last rank's slab is missing:
+#              every rank exits 1, one error line naming that rank.
 set -u
-what="$1" scene="$2" rtfact="$3" mpiexec="$4" data="$5" work="$6"
+what="$1" scene="$2" rtfact="$3" mpiexec="$4" data="$5" work="$6" compare="${7:-}"
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
 launch=("$mpiexec" --oversubscribe --allow-run-as-root)
 fails=0
@@ -31,7 +38,99 @@ esac
 # Every float of every pixel equal (idiff exits 0 only when no value differs at all).
 same() { idiff -fail 0 -failpercent 0 -warn 0 single.exr "$1" >/dev/null; }
 
-if [ "$what" = identical ]; then
+# --stats value of KEY in FILE.
+stat_of() { grep "^$2=" "$1" | head -1 | cut -d= -f2; }
+
+if [ "$what" = data ]; then
+  "$rtfact" gen volume phantom --size 64 --quiet -o phantom.mhd || fail "gen phantom"
+  "$rtfact" gen volume slab --size 64 --thickness 40 --quiet -o slab.mhd || fail "gen slab"
+  vcommon=(--size 160x120 --threads 1 --quiet)
+  # The seam test's TF: translucent (3% opacity per voxel at 255), so no ray terminates
+  # early and one sample too many or too few at a slab border (1.5% alpha) would show.
+  echo '{"name":"seam","space":"data","colors":[[0,1,1,1],[255,1,1,1]],"opacity":[[0,0],[128,0],[255,0.03]]}' \
+    >seam.json
+  for vol in phantom:dvr phantom:shaded slab:dvr; do
+    name=${vol%%:*} mode=${vol##*:}
+    extra=()
+    [ "$name" = slab ] && extra=(--tf seam.json)
+    timeout 300 "$rtfact" volume "$name.mhd" --mode "$mode" "${extra[@]}" "${vcommon[@]}" -o "$name-$mode.exr" ||
+      fail "$name $mode: single-process render"
+    for np in 2 3 4; do
+      [ "$mode" = shaded ] && [ "$np" != 3 ] && continue # the ghost slices' gradients: one run
+      out="$name-$mode-np$np.exr"
+      timeout 300 "${launch[@]}" -np "$np" "$rtfact" volume "$name.mhd" --mode "$mode" "${extra[@]}" "${vcommon[@]}" \
+        --distribute data --stats -o "$out" >"$out.stats" 2>"$out.err" || {
+        fail "$name $mode -np $np exited $?: $(cat "$out.err")"
+        continue
+      }
+      cmp=$("$compare" "$name-$mode.exr" "$out") || fail "$name $mode -np $np: $cmp"
+      echo "$name $mode -np $np: $cmp"
+      # No seam: every float within 1e-4 of one process (re-associated rounding only).
+      if [ "$name" = slab ]; then
+        idiff -fail 1e-4 -failpercent 0 "$name-$mode.exr" "$out" >/dev/null ||
+          fail "slab -np $np: differs by more than 1e-4 (a seam at a slab border?): $(idiff "$name-$mode.exr" "$out" | grep Max)"
+      fi
+      [ "$(stat_of "$out.stats" mpi_distribute)" = data ] || fail "$name -np $np: not data-parallel"
+      # Each rank read its slab plus ghosts: at most ceil(63 cells / N) + 1 planes + 2 x 2
+      # ghost slices of 64 x 64 x 2 bytes, and together about the volume once.
+      bound=$(((63 + np - 1) / np + 1 + 4))
+      total=0
+      for ((r = 0; r < np; r++)); do
+        bytes=$(stat_of "$out.stats" "rank${r}_loaded_bytes")
+        [ -n "$bytes" ] && [ "$bytes" -gt 0 ] && [ "$bytes" -le $((bound * 8192)) ] ||
+          fail "$name -np $np: rank $r loaded '$bytes' bytes, more than $bound slices"
+        total=$((total + ${bytes:-0}))
+        [ "$(stat_of "$out.stats" "rank${r}_bytes")" -gt 0 ] || fail "$name -np $np: rank $r moved no bytes"
+      done
+      [ "$total" -le $(((64 + np * 6) * 8192)) ] || fail "$name -np $np: ranks loaded $total bytes together"
+    done
+  done
+  # NRRD over the same voxels, raw (one seek per slab) and gzip (decompressed up to the
+  # slab): the same image as the MetaImage on one process.
+  gzip -kf phantom.raw
+  for enc in raw:phantom.raw gzip:phantom.raw.gz; do
+    printf 'NRRD0004\ntype: unsigned short\ndimension: 3\nsizes: 64 64 64\nendian: little\nencoding: %s\ndata file: %s\n' \
+      "${enc%%:*}" "${enc##*:}" >"phantom-${enc%%:*}.nhdr"
+    out="nrrd-${enc%%:*}.exr"
+    timeout 300 "${launch[@]}" -np 3 "$rtfact" volume "phantom-${enc%%:*}.nhdr" "${vcommon[@]}" --distribute data \
+      -o "$out" 2>"$out.err" || fail "nrrd ${enc%%:*} -np 3: $(cat "$out.err")"
+    cmp=$("$compare" phantom-dvr.exr "$out") || fail "nrrd ${enc%%:*} -np 3: $cmp"
+  done
+  # Resident memory: a 256^3 u16 volume (32 MiB) on 4 ranks; each rank's peak above the
+  # peak of the same run on a 64^3 volume (the process and MPI baseline) stays within
+  # 3 x its slab (dense slab + bricked copy), far below the 2 x 32 MiB one process needs.
+  "$rtfact" gen volume phantom --size 256 --quiet -o big.mhd || fail "gen big"
+  for v in phantom big; do
+    timeout 300 "${launch[@]}" -np 4 "$rtfact" volume "$v.mhd" "${vcommon[@]}" --distribute data --stats \
+      -o "$v-mem.exr" >"$v-mem.stats" 2>"$v-mem.err" || fail "$v memory run: $(cat "$v-mem.err")"
+  done
+  for r in 0 1 2 3; do
+    small=$(stat_of phantom-mem.stats "rank${r}_vmhwm_kb") big=$(stat_of big-mem.stats "rank${r}_vmhwm_kb")
+    loaded=$(stat_of big-mem.stats "rank${r}_loaded_bytes")
+    echo "rank $r: VmHWM ${small} kB (64^3) ${big} kB (256^3), slab ${loaded} bytes"
+    [ $((loaded)) -le $((32 * 1024 * 1024 / 4 + 6 * 256 * 256 * 2)) ] || fail "rank $r loaded $loaded bytes of 32 MiB"
+    [ $(((big - small) * 1024)) -le $((3 * loaded)) ] ||
+      fail "rank $r: VmHWM grew by $(((big - small) / 1024)) MiB for a slab of $((loaded / 1048576)) MiB"
+  done
+elif [ "$what" = data_failing ]; then
+  "$rtfact" gen volume phantom --size 64 --quiet -o cut.mhd || fail "gen"
+  # Cut the last 3 slices: the last of 4 ranks (planes 47..63 plus ghosts) lacks its
+  # slab, the others (up to plane 50) have theirs.
+  truncate -s $((61 * 64 * 64 * 2)) cut.raw
+  timeout 120 "${launch[@]}" -np 4 "$rtfact" volume cut.mhd --size 64x48 --threads 1 --quiet --distribute data \
+    -o cut.png >cut.out 2>cut.err
+  rc=$?
+  [ "$rc" = 124 ] && fail "truncated volume: mpirun hung (timeout)"
+  [ "$rc" = 1 ] || fail "truncated volume: mpirun exited $rc, want 1"
+  lines=$(grep -c "^rtfact: error:" cut.err)
+  [ "$lines" = 1 ] || fail "truncated volume: $lines error lines, want 1: $(cat cut.err)"
+  grep -q "^rtfact: error: rank 3: .*cut.raw" cut.err || fail "truncated volume: the line does not name rank 3: $(cat cut.err)"
+  [ -e cut.png ] && fail "truncated volume: an image was written"
+  # Image-parallel needs the whole file on every rank: rank 0 names it.
+  timeout 120 "${launch[@]}" -np 2 "$rtfact" volume cut.mhd --size 64x48 --threads 1 --quiet --distribute image \
+    -o cut.png >/dev/null 2>cut-image.err
+  grep -q "^rtfact: error: rank 0: .*cut.raw" cut-image.err || fail "image-parallel on a cut file: $(cat cut-image.err)"
+elif [ "$what" = identical ]; then
   timeout 300 "$rtfact" "${args[@]}" "${common[@]}" -o single.exr || fail "single-process render"
   for np in 1 2 3 4; do
     out="np$np.exr"
@@ -75,7 +174,7 @@ else
     >/dev/null 2>data.err
   rc=$?
   [ "$rc" = 2 ] || fail "--distribute data: exit $rc, want 2"
-  grep -q "not supported yet" data.err || fail "--distribute data: no 'not supported yet' in: $(cat data.err)"
+  grep -q "data-parallel rendering is for volumes" data.err || fail "--distribute data: no usage message in: $(cat data.err)"
 fi
 [ "$fails" = 0 ] && echo "mpi $what $scene: ok"
 exit $((fails > 0))
