@@ -205,6 +205,61 @@ void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr,
     }
 }
 
+// Secondary rays one by one through a given wide tree (layout variants of the wide BVH).
+template <class Tree>
+void wideSecondary(const Tree& w, const SecondaryRays& sr, size_t b, size_t e, bool ao, std::vector<float>& out) {
+    const WideBVHIntersector<TriangleIntersector> isect;
+    for (size_t i = b; i < e; ++i) {
+        RayPacket<1> r;
+        r.setLane(0, sr.org[i], sr.dir[i], 0.0f, ao ? sr.tMaxAO : kInfinity);
+        r.finalize();
+        if (ao) {
+            out[i] = isect.occluded<false>(w, r, Mask<1>(true))[0] ? 1.0f : 0.0f;
+        } else {
+            TriangleIntersector::Hit<1> h;
+            isect.intersect<false, HitData::Shading>(w, r, h, Mask<1>(true));
+            out[i] = int32_t(h.id) >= 0 ? float(h.t) : kInfinity;
+        }
+    }
+}
+
+// Arity K and leaf block L of the wide BVH against the default (kMeshWideArity,
+// kMeshLeafBlock): build time and AO / bounce throughput, as ratios to Embree's figures.
+template <int K, int L>
+void wideVariant(const Mesh& mesh, const SecondaryRays& sr, const std::vector<int>& threadCounts, int repeat,
+                 const double (*embreeMrays)[2]) {
+    WideSAHBVHBuilder b;
+    b.leafBlock = L;
+    b.maxLeafSize = 4 * L;
+    const auto t0 = Clock::now();
+    WideBVHTopology<K> topo;
+    const std::vector<AABB> bounds = meshTriangleBounds(mesh);
+    b.build(std::span<const AABB>(bounds), topo);
+    const auto w =
+        packLeafBlocks<TriangleBlock<L>>(std::move(topo), [&](TriangleBlock<L>& blk, const uint32_t* ids, int n) {
+            blk.fill(ids, n, [&](uint32_t t) {
+                return Triangle{mesh.positions[mesh.indices[3 * t]], mesh.positions[mesh.indices[3 * t + 1]],
+                                mesh.positions[mesh.indices[3 * t + 2]]};
+            });
+        });
+    const double buildMs = msSince(t0);
+    std::vector<float> out(sr.size());
+    for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
+        const int T = threadCounts[ti];
+        double ms[2] = {1e30, 1e30};
+        for (int r = 0; r < repeat; ++r)
+            for (int ao = 0; ao < 2; ++ao)
+                ms[ao] = std::min(ms[ao], timeRange(T, sr.size(), 16384, [&](size_t bb, size_t en) {
+                                      wideSecondary(w, sr, bb, en, ao != 0, out);
+                                  }));
+        const double aoM = double(sr.size()) / (ms[1] * 1000.0), bnM = double(sr.size()) / (ms[0] * 1000.0);
+        std::printf(
+            "wide_variant K=%d block=%d threads=%d build_ms_all_threads=%.2f memory_bytes=%zu ao_mrays=%.2f "
+            "bounce_mrays=%.2f ratio_ao_vs_embree=%.3f ratio_bounce_vs_embree=%.3f\n",
+            K, L, T, buildMs, w.memoryBytes(), aoM, bnM, aoM / embreeMrays[ti][1], bnM / embreeMrays[ti][0]);
+    }
+}
+
 // ---- Embree -----------------------------------------------------------------------------
 
 struct EmbreeSide {
@@ -362,7 +417,7 @@ uint64_t countHits(const Frame& f) {
 
 template <int N>
 int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat,
-        int secSamples) {
+        int secSamples, bool wideVariants) {
     std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w,
                 h, N, allThreads);
     auto meshPtr = std::make_shared<const Mesh>(mesh);
@@ -372,7 +427,8 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     // Build and memory figures are the packet BVH's, which serves the primary and shadow
     // rays compared with Embree; the wide BVH for single rays is built and timed after.
     scene.buildWide = false;
-    double rtBuild[2] = {1e30, 1e30}, emBuild[2] = {1e30, 1e30};
+    double rtBuild[2] = {1e30, 1e30}, emBuild[2] = {1e30, 1e30}, wideBuild[2] = {1e30, 1e30};
+    size_t wideBytes = 0;
     std::unique_ptr<EmbreeSide> em;
     for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
         const int T = threadCounts[ti];
@@ -383,8 +439,15 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
             arena.execute([&] { scene.build(); });
             rtBuild[ti] = std::min(rtBuild[ti], msSince(t0));
             arena.execute([&] { emBuild[ti] = std::min(emBuild[ti], em->build(mesh)); });
+            // The wide BVH (direct wide SAH build and triangle blocks) on its own.
+            MeshWideBVH wide;
+            const auto t1 = Clock::now();
+            arena.execute([&] { wide = buildMeshWideBVH(mesh, meshTriangleBounds(mesh)); });
+            wideBuild[ti] = std::min(wideBuild[ti], msSince(t1));
+            wideBytes = wide.memoryBytes();
         }
-        std::printf("build_ms_threads%d: rtfact=%.2f embree=%.2f\n", T, rtBuild[ti], emBuild[ti]);
+        std::printf("build_ms_threads%d: rtfact=%.2f rtfact_wide=%.2f embree=%.2f ratio_wide=%.3f\n", T, rtBuild[ti],
+                    wideBuild[ti], emBuild[ti], wideBuild[ti] / emBuild[ti]);
     }
     const double rtBytes = double(scene.memoryBytes()), emBytes = double(gEmbreeBytes.load());
     {
@@ -395,6 +458,8 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     }
     std::printf("memory_bytes: rtfact=%.0f embree=%.0f ratio_memory=%.3f\n", rtBytes, emBytes,
                 rtBytes / std::max(emBytes, 1.0));
+    std::printf("memory_bytes: rtfact_wide=%.0f embree=%.0f ratio_memory_wide=%.3f\n", double(wideBytes), emBytes,
+                double(wideBytes) / std::max(emBytes, 1.0));
 
     RTfactSide<N> rt{scene, setup};
     Frame fr(w, h), fe(w, h), base(w, h);
@@ -442,9 +507,11 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
         const SecondaryRays sr = makeSecondary(base, setup, scene.bounds(), secSamples, N);
         std::printf("secondary_rays=%zu (%d per primary hit, AO length %.4g)\n", sr.size(), secSamples, sr.tMaxAO);
         std::vector<float> outP(sr.size()), outW(sr.size()), outE(sr.size());
+        double embreeMrays[2][2] = {{0, 0}, {0, 0}};  // [thread count index][ao]
         for (int ao = 1; ao >= 0; --ao) {
             const char* name = ao ? "ao_occluded" : "bounce_nearest";
-            for (int T : threadCounts) {
+            for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
+                const int T = threadCounts[ti];
                 Result p, wd, e;
                 for (int r = 0; r < repeat; ++r) {
                     p.ms = std::min(p.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
@@ -458,6 +525,7 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
                                     }));
                 }
                 p.rays = wd.rays = e.rays = sr.size();
+                embreeMrays[ti][ao] = e.mrays();
                 std::printf(
                     "threads=%d %s_mrays: rtfact_wide_single=%.2f rtfact_packet%d=%.2f embree_single=%.2f "
                     "ratio_wide_vs_embree=%.3f ratio_wide_vs_packet=%.3f\n",
@@ -475,6 +543,14 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
             }
             std::printf("agreement_%s: packet_vs_wide_diff=%zu wide_vs_embree_diff=%zu\n", name, diffPW, diffWE);
         }
+        if (wideVariants) {
+            wideVariant<8, 4>(mesh, sr, threadCounts, repeat, embreeMrays);
+            wideVariant<8, 8>(mesh, sr, threadCounts, repeat, embreeMrays);
+            if constexpr (simd::kNativeWidth >= 16) {
+                wideVariant<16, 4>(mesh, sr, threadCounts, repeat, embreeMrays);
+                wideVariant<16, 8>(mesh, sr, threadCounts, repeat, embreeMrays);
+            }
+        }
     }
     // Agreement of the two tracers (a sanity check, not a timing).
     size_t hitDiff = 0, rtOnlyShadow = 0, emOnlyShadow = 0;
@@ -487,8 +563,8 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     std::printf("agreement: primary_hit_diff_pixels=%zu shadowed_only_by_rtfact=%zu shadowed_only_by_embree=%zu\n",
                 hitDiff, rtOnlyShadow, emOnlyShadow);
     const int last = int(threadCounts.size()) - 1;
-    std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\nratio_build=%.3f\n", worstPrimary, worstShadow,
-                rtBuild[last] / emBuild[last]);
+    std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\nratio_build=%.3f\nratio_build_wide=%.3f\n", worstPrimary,
+                worstShadow, rtBuild[last] / emBuild[last], wideBuild[last] / emBuild[last]);
     std::printf(
         "(ratios: RTfact/Embree throughput, the worse of 1 and %d threads; build: RTfact/Embree time at %d threads, "
         "lower is better)\n",
@@ -503,6 +579,7 @@ int benchMesh(int argc, char** argv) {
     std::string file, eye, at, up, size = "1024x1024";
     float fov = 45.0f;
     int threads = 0, packet = 256, repeat = 3, grid = 1, secondary = 4;
+    bool wideVariants = false;
     app.add_option("FILE", file, "Mesh file")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
     app.add_option("--at", at, "Camera target x,y,z");
@@ -522,6 +599,8 @@ int benchMesh(int argc, char** argv) {
     app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")
         ->capture_default_str()
         ->check(CLI::Range(1, 100));
+    app.add_flag("--wide-variants", wideVariants,
+                 "Also time wide BVH layouts (arity 8/16, leaf blocks of 4/8 triangles) on the secondary rays");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -574,9 +653,9 @@ int benchMesh(int argc, char** argv) {
         setup.triNormal[i] = normalize(cross(b - a, c - a));
     }
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat, secondary);
-    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat, secondary);
-    return run<256>(file, mesh, setup, w, h, all, repeat, secondary);
+    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants);
+    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants);
+    return run<256>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants);
 }
 
 }  // namespace rtfact::bench

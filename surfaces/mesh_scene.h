@@ -16,6 +16,7 @@
 #include "core/accel/kdtree_intersector.h"
 #include "core/accel/sah_bvh_builder.h"
 #include "core/accel/sah_kdtree_builder.h"
+#include "core/accel/wide_bvh_builder.h"
 #include "core/accel/wide_bvh_intersector.h"
 #include "core/concepts/scene.h"
 #include "core/render/secondary_rays.h"
@@ -33,6 +34,23 @@ inline std::vector<Triangle> meshTriangles(const Mesh& m) {
     for (size_t i = 0; i < t.size(); ++i)
         t[i] = {m.positions[m.indices[3 * i]], m.positions[m.indices[3 * i + 1]], m.positions[m.indices[3 * i + 2]]};
     return t;
+}
+
+// Bounds of the triangles in index order, computed in parallel on huge pages.
+inline std::vector<AABB> meshTriangleBounds(const Mesh& m) {
+    const size_t n = m.triangles();
+    std::vector<AABB> bounds;
+    resizeHugePages(bounds, n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            AABB b;
+            b.extend(m.positions[m.indices[3 * i]])
+                .extend(m.positions[m.indices[3 * i + 1]])
+                .extend(m.positions[m.indices[3 * i + 2]]);
+            bounds[i] = b;
+        }
+    });
+    return bounds;
 }
 
 template <class Structure>
@@ -57,18 +75,46 @@ inline InPlaceSAHBVHBuilder meshBVHBuilder() {
     return b;
 }
 
-// Arity of the wide BVH that serves incoherent single rays (one AVX/AVX-512 op per slab).
-inline constexpr int kMeshWideArity = 8;
+// Arity of the wide BVH that serves incoherent single rays (one AVX/AVX-512 op per slab)
+// and the width of its triangle leaf blocks (one AVX test per block). Measured with
+// `rtfact-bench mesh --wide-variants` (docs/architecture.md): blocks of 8 beat blocks of
+// 4 on AO rays, and 16-wide nodes beat 8-wide ones where one AVX-512 op tests them.
+inline constexpr int kMeshWideArity = simd::kNativeWidth >= 16 ? 16 : 8;
+inline constexpr int kMeshLeafBlock = 8;
+
+// The wide BVH builder used for meshes: leaves costed in whole triangle blocks.
+inline WideSAHBVHBuilder meshWideBVHBuilder() {
+    WideSAHBVHBuilder b;
+    b.leafBlock = kMeshLeafBlock;
+    b.maxLeafSize = 4 * kMeshLeafBlock;
+    return b;
+}
+using MeshWideBVH = BlockedWideBVH<TriangleBlock<kMeshLeafBlock>, kMeshWideArity>;
+
+// The wide BVH of a mesh from its triangle bounds (index order): built directly, then
+// the leaves packed into triangle blocks straight from the indexed mesh.
+inline MeshWideBVH buildMeshWideBVH(const Mesh& m, std::span<const AABB> bounds) {
+    WideBVHTopology<kMeshWideArity> topo;
+    meshWideBVHBuilder().build(bounds, topo);
+    using Block = TriangleBlock<kMeshLeafBlock>;
+    return packLeafBlocks<Block>(std::move(topo), [&](Block& b, const uint32_t* ids, int cnt) {
+        b.fill(ids, cnt, [&](uint32_t t) {
+            return Triangle{m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]],
+                            m.positions[m.indices[3 * t + 2]]};
+        });
+    });
+}
 
 template <class Structure = BVH<Triangle>>
 struct MeshScene {
     std::shared_ptr<const Mesh> mesh;
     Structure accel;
     Tracer<typename MeshIntersectorFor<Structure>::type> tracer;
-    // Incoherent rays (AO, diffuse bounces) go one by one through a wide BVH collapsed
-    // from the packet BVH (BVH scenes only; kd-tree scenes answer them with `accel`).
+    // Incoherent rays (AO, diffuse bounces) go one by one through a wide BVH built
+    // directly with SIMD blocks of triangles as leaves (BVH scenes only; kd-tree scenes
+    // answer them with `accel`).
     bool buildWide = true;  // set before build()
-    WideBVH<Triangle, kMeshWideArity> wide;
+    MeshWideBVH wide;
     Tracer<WideBVHIntersector<TriangleIntersector>> wideTracer;
     // When set, counts the rays the wide BVH answered: tests check that the wide path
     // really runs (null by default: one branch per query, no shared cache line).
@@ -88,17 +134,7 @@ struct MeshScene {
             // intermediate triangle array: first-touch page faults dominate big builds).
             const Mesh& m = *mesh;
             const size_t n = m.triangles();
-            std::vector<AABB> bounds;
-            resizeHugePages(bounds, n);
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t i = r.begin(); i != r.end(); ++i) {
-                    AABB b;
-                    b.extend(m.positions[m.indices[3 * i]])
-                        .extend(m.positions[m.indices[3 * i + 1]])
-                        .extend(m.positions[m.indices[3 * i + 2]]);
-                    bounds[i] = b;
-                }
-            });
+            const std::vector<AABB> bounds = meshTriangleBounds(m);
             accel = BVH<Triangle>{};
             meshBVHBuilder().build(std::span<const AABB>(bounds), static_cast<BVHTopology&>(accel));
             resizeHugePages(accel.elems, n);
@@ -110,14 +146,7 @@ struct MeshScene {
                 }
             });
             wide = {};
-            if (buildWide) {
-                static_cast<WideBVHTopology<kMeshWideArity>&>(wide) =
-                    collapseBVH<kMeshWideArity>(static_cast<const BVHTopology&>(accel));
-                resizeHugePages(wide.elems, n);
-                tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
-                    for (size_t i = r.begin(); i != r.end(); ++i) wide.elems[i] = accel.elems[i];
-                });
-            }
+            if (buildWide) wide = buildMeshWideBVH(m, std::span<const AABB>(bounds));
         } else {
             const std::vector<Triangle> tris = meshTriangles(*mesh);
             accel = buildKdTree<Triangle>(SAHKdTreeBuilder{}, std::span<const Triangle>(tris));
@@ -232,5 +261,6 @@ static_assert(IncoherentQueries<MeshScene<BVH<Triangle>>, 1> &&
               IncoherentQueries<MeshScene<BVH<Triangle>>, simd::kNativeWidth> &&
               IncoherentQueries<MeshScene<BVH<Triangle>>, 64>);
 static_assert(Intersector<WideBVHIntersector<TriangleIntersector>, WideBVH<Triangle, kMeshWideArity>>);
+static_assert(Intersector<WideBVHIntersector<TriangleIntersector>, MeshWideBVH>);
 
 }  // namespace rtfact::surfaces

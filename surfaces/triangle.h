@@ -12,6 +12,7 @@
 #pragma once
 #include <algorithm>
 
+#include "core/accel/wide_bvh_intersector.h"
 #include "core/concepts/intersector.h"
 #include "core/concepts/intersector_hooks.h"
 #include "core/simd/bitmask.h"
@@ -36,6 +37,31 @@ template <class V>
 RTFACT_INLINE V triangleEdge(const V& p, const V& q) {
     return cross(q - p, p + q);
 }
+
+// Up to L triangles in structure-of-arrays form (vertex, axis, lane) with their ids: the
+// leaf block of a BlockedWideBVH, tested with one SIMD edge-function test and no
+// gathers. Unused lanes repeat the last triangle (same id, same result).
+template <int L>
+struct alignas(L * 4) TriangleBlock {
+    using Element = Triangle;
+    static constexpr int kSize = L;
+    float v[3][3][L];  // v[vertex][axis][lane]
+    int32_t id[L];
+
+    // Lanes from input indices ids[0..n); tri(i) returns input triangle i.
+    template <class Get>
+    void fill(const uint32_t* ids, int n, const Get& tri) {
+        for (int i = 0; i < L; ++i) {
+            const uint32_t k = ids[std::min(i, n - 1)];
+            const Triangle t = tri(k);
+            const Vec3f* vs[3] = {&t.v0, &t.v1, &t.v2};
+            for (int j = 0; j < 3; ++j)
+                for (int a = 0; a < 3; ++a) v[j][a][i] = (*vs[j])[a];
+            id[i] = int32_t(k);
+        }
+    }
+};
+static_assert(LeafBlock<TriangleBlock<4>> && LeafBlock<TriangleBlock<8>>);
 
 struct TriangleIntersector {
     template <int N>
@@ -137,9 +163,74 @@ struct TriangleIntersector {
             }
         }
     }
+
+    // Blocks of a BlockedWideBVH leaf: the same arithmetic as intersectLeaf, loaded
+    // straight from structure-of-arrays.
+    template <HitData D, int L>
+    RTFACT_INLINE void intersectBlocks(const TriangleBlock<L>* blocks, int n, const RayPacket<1>& ray,
+                                       Hit<1>& hit) const {
+        using P = Packet<L>;
+        const P inf(kInfinity);
+        for (int k = 0; k < n; ++k) {
+            P e0, e1, e2, t;
+            const auto m = blockTest(blocks[k], ray, float(hit.t), e0, e1, e2, t);
+            if (none(m)) continue;
+            const P tm = select(m, t, inf);
+            const float best = hmin(tm);
+            const int lane = BitMask<L>(tm == P(best)).first();
+            hit.t = best;
+            hit.id = blocks[k].id[lane];
+            if constexpr (D == HitData::Shading) {
+                const float inv = 1.0f / (e0[lane] + e1[lane] + e2[lane]);
+                hit.u = e1[lane] * inv;
+                hit.v = e2[lane] * inv;
+            }
+        }
+    }
+    // Any hit in (tMin, hit.t): records it in hit and returns true.
+    template <int L>
+    RTFACT_INLINE bool occludedBlocks(const TriangleBlock<L>* blocks, int n, const RayPacket<1>& ray,
+                                      Hit<1>& hit) const {
+        using P = Packet<L>;
+        for (int k = 0; k < n; ++k) {
+            P e0, e1, e2, t;
+            const auto m = blockTest(blocks[k], ray, float(hit.t), e0, e1, e2, t);
+            if (none(m)) continue;
+            const int lane = BitMask<L>(m).first();
+            hit.t = t[lane];
+            hit.id = blocks[k].id[lane];
+            return true;
+        }
+        return false;
+    }
+
+   private:
+    template <int L>
+    static RTFACT_INLINE auto blockTest(const TriangleBlock<L>& b, const RayPacket<1>& ray, float tFar, Packet<L>& e0,
+                                        Packet<L>& e1, Packet<L>& e2, Packet<L>& t) {
+        using P = Packet<L>;
+        const P ox(ray.org.x[0]), oy(ray.org.y[0]), oz(ray.org.z[0]);
+        const Vec3<L> d(Vec3f(ray.dir.x[0], ray.dir.y[0], ray.dir.z[0]));
+        const Vec3<L> a(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
+        const Vec3<L> bb(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
+        const Vec3<L> c(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
+        // Same values as the per-triangle test: n = (v1 - v0) x (v2 - v0).
+        const Vec3<L> nn = cross(bb - a, c - a);
+        e0 = dot(triangleEdge(bb, c), d);
+        e1 = dot(triangleEdge(c, a), d);
+        e2 = dot(triangleEdge(a, bb), d);
+        const P nd = dot(nn, d);
+        const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
+        const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != P(0.0f));
+        t = dot(nn, a) / nd;
+        return inside & (t > P(float(ray.tMin))) & (t < P(tFar));
+    }
 };
 static_assert(ElementIntersector<TriangleIntersector, Triangle>);
 // The wide BVH tests whole leaves through this hook (else one triangle at a time).
 static_assert(LeafIntersector<TriangleIntersector, Triangle>);
+// ... and SIMD blocks of triangles in a BlockedWideBVH.
+static_assert(BlockIntersector<TriangleIntersector, TriangleBlock<4>> &&
+              BlockIntersector<TriangleIntersector, TriangleBlock<8>>);
 
 }  // namespace rtfact::surfaces

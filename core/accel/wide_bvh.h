@@ -1,15 +1,24 @@
-// WideBVH<Elem, K>: a K-ary BVH (K = 4, 8 or 16) collapsed from a binary BVHTopology,
-// for single-ray traversal that tests one ray against all K child boxes with one SIMD
-// op per slab. Nodes are structure-of-arrays (K floats per bound and axis); elements
-// are in the leaf order of the binary BVH, so a leaf is a contiguous range.
+// WideBVH<Elem, K>: a K-ary BVH (K = 4, 8 or 16), for single-ray traversal that tests
+// one ray against all K child boxes with one SIMD op per slab. Nodes are
+// structure-of-arrays (K floats per bound and axis); elements are in leaf order, so a
+// leaf is a contiguous range. The topology comes either straight from a wide builder
+// (core/accel/wide_bvh_builder.h) or from collapsing a binary BVHTopology.
+// BlockedWideBVH<Block, K> stores the leaves as SIMD blocks of elements instead
+// (structure-of-arrays, one SIMD test per block, no gathers).
 #pragma once
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <concepts>
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/accel/bvh.h"
 #include "core/ray/ray_packet.h"
+#include "core/util/huge_pages.h"
 
 namespace rtfact {
 
@@ -136,10 +145,106 @@ WideBVH<Elem, K> collapseBVH(const BVH<Elem>& bvh) {
     return w;
 }
 
-// Builds the binary BVH with `builder` and collapses it.
+// Builds a wide BVH over `elems`: directly with a wide builder (WideSAHBVHBuilder), or
+// by building the binary BVH with a binary builder and collapsing it.
 template <Primitive Elem, int K = 8, class B>
-requires Builder<B, BVHTopology> WideBVH<Elem, K> buildWideBVH(const B& builder, std::span<const Elem> elems) {
-    return collapseBVH<K>(buildBVH<Elem>(builder, elems));
+requires(Builder<B, BVHTopology> ||
+         Builder<B, WideBVHTopology<K>>) WideBVH<Elem, K> buildWideBVH(const B& builder, std::span<const Elem> elems) {
+    if constexpr (Builder<B, WideBVHTopology<K>>) {
+        std::vector<AABB> bounds(elems.size());
+        for (size_t i = 0; i < elems.size(); ++i) bounds[i] = elems[i].bounds();
+        WideBVH<Elem, K> w;
+        builder.build(std::span<const AABB>(bounds), static_cast<WideBVHTopology<K>&>(w));
+        w.elems.resize(w.order.size());
+        for (size_t i = 0; i < w.order.size(); ++i) w.elems[i] = elems[w.order[i]];
+        return w;
+    } else {
+        return collapseBVH<K>(buildBVH<Elem>(builder, elems));
+    }
+}
+
+// Allocator that leaves new elements uninitialised (large arrays that are filled in
+// parallel right after: no serial zeroing pass, first touch by the filling threads).
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+        using other = UninitAllocator<U>;
+    };
+    UninitAllocator() = default;
+    template <class U>
+    UninitAllocator(const UninitAllocator<U>&) {}  // NOLINT: allocator conversion
+    template <class U>
+    void construct(U* p) noexcept {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... A>
+    void construct(U* p, A&&... a) {
+        ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+    }
+};
+
+// A leaf block: up to kSize elements in structure-of-arrays form, tested against a ray
+// with one SIMD op per field. fill(ids, n, get) writes the block from n input indices
+// (get(i) returns input element i; unused lanes repeat the last element).
+template <class B>
+concept LeafBlock = requires {
+    { B::kSize } -> std::convertible_to<int>;
+    typename B::Element;
+};
+
+// A wide BVH whose leaves are blocks: a leaf slot's child is its first block and its
+// count the number of elements (ceil(count / kSize) consecutive blocks).
+template <LeafBlock Block, int K = 8>
+struct BlockedWideBVH : WideBVHTopology<K> {
+    using BlockType = Block;
+    static constexpr int kBlock = Block::kSize;
+    std::vector<Block, UninitAllocator<Block>> blocks;
+
+    static int blockCount(int elements) { return (elements + kBlock - 1) / kBlock; }
+    size_t memoryBytes() const {
+        return this->nodes.size() * sizeof(WideBVHNode<K>) + blocks.size() * sizeof(Block) +
+               this->order.size() * sizeof(uint32_t);
+    }
+};
+
+// Turns the element-range leaves of a wide topology into blocks, in parallel:
+// fill(block, ids, n) writes one block from n <= kSize input indices.
+template <LeafBlock Block, int K, class Fill>
+BlockedWideBVH<Block, K> packLeafBlocks(WideBVHTopology<K>&& t, const Fill& fill) {
+    constexpr int S = Block::kSize;
+    BlockedWideBVH<Block, K> out;
+    static_cast<WideBVHTopology<K>&>(out) = std::move(t);
+    const size_t n = out.order.size(), nn = out.nodes.size();
+    if (n == 0) return out;
+    // First block of each leaf, by the leaf's first element (leaves tile [0, n)); only
+    // leaf starts are written and read.
+    std::unique_ptr<uint32_t[]> first(new uint32_t[n]);
+    auto* nodes = out.nodes.data();
+    tbb::parallel_for(size_t(0), nn, [&](size_t ni) {
+        for (int i = 0; i < K; ++i)
+            if (nodes[ni].isLeaf(i)) first[size_t(nodes[ni].child[i])] = uint32_t(nodes[ni].count[i]);
+    });
+    uint32_t nb = 0;
+    for (size_t i = 0; i < n;) {
+        const uint32_t c = first[i];
+        first[i] = nb;
+        nb += uint32_t((c + S - 1) / S);
+        i += c;
+    }
+    resizeHugePages(out.blocks, nb);
+    const uint32_t* order = out.order.data();
+    Block* blocks = out.blocks.data();
+    tbb::parallel_for(size_t(0), nn, [&](size_t ni) {
+        for (int i = 0; i < K; ++i) {
+            if (!nodes[ni].isLeaf(i)) continue;
+            const uint32_t e = uint32_t(nodes[ni].child[i]), c = uint32_t(nodes[ni].count[i]), b = first[e];
+            for (uint32_t j = 0; j * S < c; ++j)
+                fill(blocks[b + j], order + e + j * S, int(std::min<uint32_t>(S, c - j * S)));
+            nodes[ni].child[i] = int32_t(b);
+        }
+    });
+    return out;
 }
 
 }  // namespace rtfact

@@ -1,11 +1,11 @@
-// Single-ray traversal of a WideBVH<Elem, K>, calling a nested element intersector at
-// the leaves. One ray is tested against the K child boxes of a node at once (one SIMD
-// op per slab plane), the children hit are visited near to far and stack entries keep
-// their entry distance so they are skipped once a closer hit is known. Incoherent rays
-// (AO, diffuse bounces) gain nothing from packets; packets of N > 1 lanes are served
-// by looping the single-ray path over the active lanes, so an integrator picks at
-// compile time which structure serves which rays.
+// Single-ray traversal of a WideBVH<Elem, K> or a BlockedWideBVH<Block, K>, calling a
+// nested element intersector at the leaves (per element, per leaf or per SIMD block). One ray is tested against the K
+// child boxes of a node at once (one SIMD op per slab plane), the children hit are visited near to far and stack
+// entries keep their entry distance so they are skipped once a closer hit is known. Incoherent rays (AO, diffuse
+// bounces) gain nothing from packets; packets of N > 1 lanes are served by looping the single-ray path over the active
+// lanes, so an integrator picks at compile time which structure serves which rays.
 #pragma once
+#include <concepts>
 #include <cstring>
 #include <type_traits>
 
@@ -17,14 +17,23 @@
 
 namespace rtfact {
 
+// Block leaves (BlockedWideBVH): the element intersector tests n consecutive blocks.
+template <class I, class Block>
+concept BlockIntersector = requires(const I& isect, const Block* blocks, int n, const RayPacket<1>& ray,
+                                    typename I::template Hit<1>& hit) {
+    isect.template intersectBlocks<HitData::Distance>(blocks, n, ray, hit);
+    isect.template intersectBlocks<HitData::Shading>(blocks, n, ray, hit);
+    { isect.template occludedBlocks(blocks, n, ray, hit) } -> std::same_as<bool>;
+};
+
 template <class ElemIsect>
 struct WideBVHIntersector {
     ElemIsect elem{};
     template <int N>
     using Hit = typename ElemIsect::template Hit<N>;
 
-    template <bool CommonOrigin, HitData D, class Elem, int K, int N>
-    void intersect(const WideBVH<Elem, K>& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
+    template <bool CommonOrigin, HitData D, class Tree, int N>
+    void intersect(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
         if constexpr (N == 1) {
             hit.t = rays.tMax;
             hit.id = -1;
@@ -43,8 +52,8 @@ struct WideBVHIntersector {
         }
     }
 
-    template <bool CommonOrigin, class Elem, int K, int N>
-    Mask<N> occluded(const WideBVH<Elem, K>& bvh, const RayPacket<N>& rays, const Mask<N>& active) const {
+    template <bool CommonOrigin, class Tree, int N>
+    Mask<N> occluded(const Tree& bvh, const RayPacket<N>& rays, const Mask<N>& active) const {
         Mask<N> occ(false);
         BitMask<N>(active).forEach([&](int i) {
             Hit<1> h;
@@ -77,16 +86,59 @@ struct WideBVHIntersector {
         for (int f = 0; f < kFields; ++f) std::memcpy(d + (size_t(f) * N + size_t(i)) * 4, s + size_t(f) * 4, 4);
     }
 
+    // One leaf (first, count) against the ray; returns true when an any-hit query is done.
     template <HitData D, bool AnyHit, class Elem, int K>
-    void traverse(const WideBVH<Elem, K>& bvh, const RayPacket<1>& ray, Hit<1>& hit) const {
+    RTFACT_INLINE bool leaf(const WideBVH<Elem, K>& bvh, int32_t first, int32_t count, const RayPacket<1>& ray,
+                            Hit<1>& hit) const {
+        // Element intersectors may test a whole leaf at once (SIMD over elements).
+        if constexpr (LeafIntersector<ElemIsect, Elem>) {
+            elem.template intersectLeaf<D>(bvh.elems.data() + first, bvh.order.data() + first, count, ray, hit);
+        } else {
+            for (int i = 0; i < count; ++i) {
+                const uint32_t ei = uint32_t(first + i);
+                elem.template intersect<D>(bvh.elems[ei], bvh.order[ei], ray, hit, 0);
+            }
+        }
+        if constexpr (AnyHit) return int32_t(hit.id) >= 0;
+        return false;
+    }
+    template <HitData D, bool AnyHit, class Block, int K>
+    RTFACT_INLINE bool leaf(const BlockedWideBVH<Block, K>& bvh, int32_t first, int32_t count, const RayPacket<1>& ray,
+                            Hit<1>& hit) const {
+        static_assert(BlockIntersector<ElemIsect, Block>, "the element intersector must test leaf blocks");
+        const Block* b = bvh.blocks.data() + first;
+        const int n = BlockedWideBVH<Block, K>::blockCount(count);
+        if constexpr (AnyHit)
+            return elem.occludedBlocks(b, n, ray, hit);
+        else
+            elem.template intersectBlocks<D>(b, n, ray, hit);
+        return false;
+    }
+
+    template <int K>
+    static RTFACT_INLINE void prefetchNode(const WideBVHNode<K>* n) {
+        const char* p = reinterpret_cast<const char*>(n);
+        for (size_t o = 0; o < sizeof(WideBVHNode<K>); o += 64) __builtin_prefetch(p + o);
+    }
+
+    // Closest hit: children hit are visited near to far (a single hit child is entered
+    // directly, more are insertion-sorted onto the stack) and a popped entry is skipped
+    // once a closer hit is known. Any hit: no ordering at all, larger children first
+    // (the builder's slot order). Every inner child entered or pushed is prefetched.
+    template <HitData D, bool AnyHit, class Tree>
+    void traverse(const Tree& bvh, const RayPacket<1>& ray, Hit<1>& hit) const {
         if (bvh.nodes.empty()) return;
+        constexpr int K = Tree::arity;
         using P = Packet<K>;
-        // Per axis: which bound array is the near plane, and the ray broadcast to K lanes.
-        int nearIdx[3];
+        const WideBVHNode<K>* nodes = bvh.nodes.data();
+        // Near and far plane of each axis, by the sign of the direction, as offsets into
+        // the node's bounds (lo[3][K] then hi[3][K]): plain loads, no per-axis select.
+        int nearOff[3], farOff[3];
         P org[3], inv[3];
         for (int a = 0; a < 3; ++a) {
             const float id = ray.invDir[a][0];
-            nearIdx[a] = id < 0.0f ? 1 : 0;
+            nearOff[a] = (id < 0.0f ? 3 * K : 0) + a * K;
+            farOff[a] = (id < 0.0f ? 0 : 3 * K) + a * K;
             inv[a] = P(id);
             org[a] = P(ray.org[a][0]);
         }
@@ -95,60 +147,70 @@ struct WideBVHIntersector {
             int32_t child, count;
             float dist;
         };
-        // Each wide level pushes at most K entries and pops one; the wide tree is no
-        // deeper than the binary one, whose traversal assumes depth < 128.
+        // Each wide level pushes at most K entries and pops one; wide trees are no deeper
+        // than the binary ones they may come from, whose traversal assumes depth < 128.
         Entry stack[(K - 1) * 128 + 1];
         int sp = 0;
         int32_t node = 0;
         for (;;) {
-            // Inner node: test all K children.
-            const WideBVHNode<K>& n = bvh.nodes[size_t(node)];
-            const float* bnd[2][3] = {{n.lo[0], n.lo[1], n.lo[2]}, {n.hi[0], n.hi[1], n.hi[2]}};
+            const WideBVHNode<K>& n = nodes[node];
+            const float* f = n.lo[0];
             P tn = tMin, tf(float(hit.t));
             for (int a = 0; a < 3; ++a) {
-                const P nearP = P::load(bnd[nearIdx[a]][a]), farP = P::load(bnd[1 - nearIdx[a]][a]);
-                tn = max(tn, (nearP - org[a]) * inv[a]);
-                tf = min(tf, (farP - org[a]) * inv[a]);
+                tn = max(tn, (P::load(f + nearOff[a]) - org[a]) * inv[a]);
+                tf = min(tf, (P::load(f + farOff[a]) - org[a]) * inv[a]);
             }
             uint64_t bits = BitMask<K>(tn <= tf).w[0];
-            const int cnt = __builtin_popcountll(bits);
-            if (cnt > 0) {
-                // Push hit children far to near (insertion by distance onto the stack top).
-                const int base = sp;
-                for (; bits; bits &= bits - 1) {
+            if constexpr (!AnyHit) {
+                if (bits && !(bits & (bits - 1))) {
                     const int c = __builtin_ctzll(bits);
-                    const Entry e{n.child[c], n.count[c], tn[c]};
-                    RTFACT_ASSERT(sp < int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the traversal stack");
-                    int j = sp++;
-                    while (j > base && stack[j - 1].dist < e.dist) {
-                        stack[j] = stack[j - 1];
-                        --j;
+                    if (!n.isLeaf(c)) {
+                        node = n.child[c];
+                        prefetchNode(nodes + node);
+                        continue;
                     }
-                    stack[j] = e;
+                }
+            }
+            if (bits) {
+                RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]),
+                              "wide BVH deeper than the traversal stack");
+                if constexpr (AnyHit) {
+                    // No ordering; the last slot is pushed first, so the first (largest)
+                    // child ends on top.
+                    while (bits) {
+                        const int c = 63 - __builtin_clzll(bits);
+                        bits &= ~(uint64_t(1) << c);
+                        if (n.count[c] == 0) prefetchNode(nodes + n.child[c]);
+                        stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
+                    }
+                } else {
+                    const int base = sp;
+                    for (; bits; bits &= bits - 1) {
+                        const int c = __builtin_ctzll(bits);
+                        const Entry e{n.child[c], n.count[c], tn[c]};
+                        if (e.count == 0) prefetchNode(nodes + e.child);
+                        // Far to near: the nearest ends on top.
+                        int j = sp++;
+                        while (j > base && stack[j - 1].dist < e.dist) {
+                            stack[j] = stack[j - 1];
+                            --j;
+                        }
+                        stack[j] = e;
+                    }
                 }
             }
             // Pop the nearest entry that can still hold a closer hit; run leaves.
             for (;;) {
                 if (sp == 0) return;
                 const Entry e = stack[--sp];
-                if (!(e.dist <= float(hit.t))) continue;
+                if constexpr (!AnyHit) {
+                    if (!(e.dist <= float(hit.t))) continue;
+                }
                 if (e.count == 0) {
                     node = e.child;
                     break;
                 }
-                // Element intersectors may test a whole leaf at once (SIMD over elements).
-                if constexpr (LeafIntersector<ElemIsect, Elem>) {
-                    elem.template intersectLeaf<D>(bvh.elems.data() + e.child, bvh.order.data() + e.child, e.count, ray,
-                                                   hit);
-                } else {
-                    for (int i = 0; i < e.count; ++i) {
-                        const uint32_t ei = uint32_t(e.child + i);
-                        elem.template intersect<D>(bvh.elems[ei], bvh.order[ei], ray, hit, 0);
-                    }
-                }
-                if constexpr (AnyHit) {
-                    if (int32_t(hit.id) >= 0) return;
-                }
+                if (leaf<D, AnyHit>(bvh, e.child, e.count, ray, hit)) return;
             }
         }
     }

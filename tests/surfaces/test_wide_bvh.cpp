@@ -1,13 +1,17 @@
 // Wide BVH (K = 4, 8, 16) and its single-ray SIMD traversal: structural invariants of
-// the collapse (every element in exactly one leaf, child boxes inside their parents)
-// and nearest-hit / occlusion queries against brute force over all elements, for
-// spheres and triangles, at packet sizes 1, native and 64.
+// the collapse and of the direct wide SAH build (every element in exactly one leaf,
+// child boxes inside their parents, leaf sizes), the triangle leaf blocks, and
+// nearest-hit / occlusion queries against brute force over all elements, for spheres
+// and triangles, at packet sizes 1, native, 64 and 256, with common and distinct
+// origins and partial packets.
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <functional>
 #include <random>
 
 #include "core/accel/sah_bvh_builder.h"
+#include "core/accel/wide_bvh_builder.h"
 #include "core/accel/wide_bvh_intersector.h"
 #include "core/geometry/sphere.h"
 #include "core/render/ao_integrator.h"
@@ -54,19 +58,23 @@ bool inside(const AABB& in, const AABB& out) {
     return true;
 }
 
-template <int K, class Elem>
-void checkStructure(const std::vector<Elem>& elems) {
-    const BVH<Elem> bin = buildBVH<Elem>(meshBVHBuilder(), std::span<const Elem>(elems));
-    const WideBVH<Elem, K> w = collapseBVH<K>(bin);
-    ASSERT_FALSE(w.nodes.empty());
-    std::vector<int> seen(elems.size(), 0);
+// Walks a wide topology from the root: every node reached once, child boxes inside
+// their parents, every element in exactly one leaf and inside its leaf's box (bounds
+// by input index). Returns the leaf sizes.
+template <int K>
+std::vector<int> checkTopology(const WideBVHTopology<K>& w, const std::vector<AABB>& bounds, bool singleLeafRoot) {
+    std::vector<int> leafSizes;
+    EXPECT_FALSE(w.nodes.empty());
+    if (w.nodes.empty()) return leafSizes;
+    std::vector<int> seen(bounds.size(), 0);
     std::vector<int> visits(w.nodes.size(), 0);
     // (node, its box as stored in the parent)
     std::vector<std::pair<int32_t, AABB>> todo{{0, w.bounds()}};
     while (!todo.empty()) {
         const auto [ni, box] = todo.back();
         todo.pop_back();
-        ASSERT_LT(size_t(ni), w.nodes.size());
+        EXPECT_LT(size_t(ni), w.nodes.size());
+        if (size_t(ni) >= w.nodes.size()) return leafSizes;
         ++visits[size_t(ni)];
         const WideBVHNode<K>& n = w.nodes[size_t(ni)];
         int used = 0;
@@ -75,34 +83,115 @@ void checkStructure(const std::vector<Elem>& elems) {
             ++used;
             EXPECT_TRUE(inside(n.box(c), box)) << "child box outside its parent";
             if (n.isLeaf(c)) {
+                leafSizes.push_back(n.count[c]);
                 for (int i = 0; i < n.count[c]; ++i) {
                     const size_t e = size_t(n.child[c] + i);
-                    ASSERT_LT(e, w.elems.size());
+                    EXPECT_LT(e, w.order.size());
+                    if (e >= w.order.size()) return leafSizes;
                     ++seen[w.order[e]];
-                    EXPECT_TRUE(inside(w.elems[e].bounds(), n.box(c))) << "element outside its leaf";
+                    EXPECT_TRUE(inside(bounds[w.order[e]], n.box(c))) << "element outside its leaf";
                 }
             } else {
                 todo.push_back({n.child[c], n.box(c)});
             }
         }
-        // Greedy collapse fills nodes unless it runs out of inner children to open.
-        EXPECT_GE(used, ni == 0 && bin.nodes[0].isLeaf() ? 1 : 2);
+        EXPECT_GE(used, ni == 0 && singleLeafRoot ? 1 : 2);
     }
     for (size_t i = 0; i < seen.size(); ++i)
-        ASSERT_EQ(seen[i], 1) << "element " << i << " reached " << seen[i] << " times";
+        EXPECT_EQ(seen[i], 1) << "element " << i << " reached " << seen[i] << " times";
     for (size_t i = 0; i < visits.size(); ++i)
-        ASSERT_EQ(visits[i], 1) << "node " << i << " reached " << visits[i] << " times";
+        EXPECT_EQ(visits[i], 1) << "node " << i << " reached " << visits[i] << " times";
+    return leafSizes;
+}
+
+template <class Elem>
+std::vector<AABB> boundsOf(const std::vector<Elem>& elems) {
+    std::vector<AABB> b;
+    for (const Elem& e : elems) b.push_back(e.bounds());
+    return b;
+}
+
+template <int K, class Elem>
+void checkStructure(const std::vector<Elem>& elems) {
+    const BVH<Elem> bin = buildBVH<Elem>(meshBVHBuilder(), std::span<const Elem>(elems));
+    const WideBVH<Elem, K> w = collapseBVH<K>(bin);
+    checkTopology<K>(w, boundsOf(elems), bin.nodes[0].isLeaf());
     // Collapsing a k-ary tree cuts the node count roughly by K / 2 at least.
     EXPECT_LT(w.nodes.size() * 2, bin.nodes.size());
 }
 
-template <class Elem, int K, int N>
+// The direct wide build: invariants, leaves of at most one block when the SAH allows
+// no better (ranges of <= leafBlock are never split; none exceeds maxLeafSize), and
+// nodes mostly full.
+template <int K, class Elem>
+void checkDirectStructure(const std::vector<Elem>& elems, int leafBlock) {
+    WideSAHBVHBuilder b;
+    b.leafBlock = leafBlock;
+    b.maxLeafSize = 4 * leafBlock;
+    WideBVHTopology<K> w;
+    const std::vector<AABB> bounds = boundsOf(elems);
+    b.build(std::span<const AABB>(bounds), w);
+    ASSERT_EQ(w.order.size(), elems.size());
+    const std::vector<int> leaves = checkTopology<K>(w, bounds, false);
+    size_t inBlock = 0;
+    for (int c : leaves) {
+        EXPECT_GE(c, 1);
+        EXPECT_LE(c, b.maxLeafSize);
+        inBlock += c <= leafBlock;
+    }
+    EXPECT_GT(inBlock * 10, leaves.size() * 6) << "most leaves fit one block";
+    // Ranges of at most one block are never split: every inner node holds more.
+    std::function<int(int32_t)> count = [&](int32_t ni) {
+        int c = 0;
+        for (int i = 0; i < K; ++i) {
+            if (w.nodes[size_t(ni)].isEmpty(i)) continue;
+            c += w.nodes[size_t(ni)].isLeaf(i) ? w.nodes[size_t(ni)].count[i] : count(w.nodes[size_t(ni)].child[i]);
+        }
+        EXPECT_GT(c, leafBlock) << "inner node " << ni << " splits a range of one block";
+        return c;
+    };
+    EXPECT_EQ(size_t(count(0)), elems.size());
+    // Nodes are mostly full: more than 3 children on average for K >= 8 (more than 2 for
+    // K = 4); widening stops early only when every child fits one block.
+    EXPECT_GT(leaves.size() + w.nodes.size() - 1, w.nodes.size() * size_t(std::min(K, 6) / 2));
+    AABB all;
+    for (const AABB& x : bounds) all.extend(x);
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_EQ(w.box.lo[a], all.lo[a]);
+        EXPECT_EQ(w.box.hi[a], all.hi[a]);
+    }
+}
+
+// The three ways to a wide tree that the traversal must serve alike.
+enum class Make { Collapse, Direct, Blocks4, Blocks8 };
+
+template <class Elem, int K, Make M>
+auto makeTree(const std::vector<Elem>& elems) {
+    if constexpr (M == Make::Collapse) {
+        return buildWideBVH<Elem, K>(SAHBVHBuilder{}, std::span<const Elem>(elems));
+    } else if constexpr (M == Make::Direct) {
+        return buildWideBVH<Elem, K>(WideSAHBVHBuilder{}, std::span<const Elem>(elems));
+    } else {
+        constexpr int L = M == Make::Blocks4 ? 4 : 8;
+        WideSAHBVHBuilder b;
+        b.leafBlock = L;
+        WideBVHTopology<K> topo;
+        const std::vector<AABB> bounds = boundsOf(elems);
+        b.build(std::span<const AABB>(bounds), topo);
+        return packLeafBlocks<TriangleBlock<L>>(std::move(topo),
+                                                [&](TriangleBlock<L>& blk, const uint32_t* ids, int n) {
+                                                    blk.fill(ids, n, [&](uint32_t i) { return elems[i]; });
+                                                });
+    }
+}
+
+template <class Elem, int K, int N, Make M = Make::Collapse>
 void checkTraversal(const std::vector<Elem>& elems, bool commonOrigin) {
     if constexpr (!simd::ValidPacketSize<N>) {
         GTEST_SKIP() << "packet size " << N << " not supported by this build";
     } else {
         using EI = decltype(elemIsect<Elem>());
-        const WideBVH<Elem, K> w = buildWideBVH<Elem, K>(SAHBVHBuilder{}, std::span<const Elem>(elems));
+        const auto w = makeTree<Elem, K, M>(elems);
         const WideBVHIntersector<EI> isect;
         std::mt19937 rng(N * 5 + K + commonOrigin);
         std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f);
@@ -210,6 +299,88 @@ TEST(WideBVH, SingleElementAndEmpty) {
         checkTraversal<Elem, K, simd::kNativeWidth>(elems, false); \
     }                                                              \
     TEST(WideBVH, Name##K##Packet64) { checkTraversal<Elem, K, 64>(elems, false); }
+
+TEST(WideBVH, DirectStructureSpheres) {
+    const auto s = testSpheres(3000);
+    checkDirectStructure<4>(s, 4);
+    checkDirectStructure<8>(s, 4);
+    checkDirectStructure<8>(s, 8);
+    checkDirectStructure<16>(s, 8);
+}
+TEST(WideBVH, DirectStructureTriangles) {
+    const auto t = testTriangles();
+    checkDirectStructure<8>(t, 4);
+    checkDirectStructure<16>(t, 8);
+}
+// Large enough for the parallel binning and out-of-place partition of the top levels.
+TEST(WideBVH, DirectStructureParallelTop) {
+    const auto s = testSpheres(70000);
+    checkDirectStructure<8>(s, 4);
+}
+// Coincident centroids (no SAH split exists): ranges are halved, leaves stay bounded.
+TEST(WideBVH, DirectStructureCoincident) {
+    const std::vector<Sphere> same(100, Sphere{Vec3f(0.5f), 0.25f});
+    checkDirectStructure<8>(same, 4);
+}
+TEST(WideBVH, DirectSingleElementAndEmpty) {
+    const std::vector<Sphere> one{{Vec3f(0.0f), 1.0f}};
+    const WideBVH<Sphere> w = buildWideBVH<Sphere>(WideSAHBVHBuilder{}, std::span<const Sphere>(one));
+    ASSERT_EQ(w.nodes.size(), 1u);
+    EXPECT_EQ(w.nodes[0].count[0], 1);
+    RayPacket<1> r;
+    r.setLane(0, Vec3f(0, 0, -5), Vec3f(0, 0, 1));
+    r.finalize();
+    SphereIntersector::Hit<1> h;
+    WideBVHIntersector<SphereIntersector>{}.intersect<false, HitData::Shading>(w, r, h, Mask<1>(true));
+    EXPECT_EQ(int32_t(h.id), 0);
+    const WideBVH<Sphere> none = buildWideBVH<Sphere>(WideSAHBVHBuilder{}, std::span<const Sphere>());
+    EXPECT_TRUE(none.nodes.empty());
+    EXPECT_FALSE(WideBVHIntersector<SphereIntersector>{}.occluded<false>(none, r, Mask<1>(true))[0]);
+}
+// Triangle blocks: every leaf's blocks hold exactly its triangles (ids), padded with
+// the last one.
+TEST(WideBVH, TriangleBlocksHoldLeafTriangles) {
+    const auto t = testTriangles();
+    const auto w = makeTree<Triangle, 8, Make::Blocks4>(t);
+    std::vector<int> seen(t.size(), 0);
+    for (const auto& n : w.nodes)
+        for (int c = 0; c < 8; ++c) {
+            if (!n.isLeaf(c)) continue;
+            const int nb = std::remove_cvref_t<decltype(w)>::blockCount(n.count[c]);
+            for (int k = 0; k < n.count[c]; ++k) {
+                const TriangleBlock<4>& b = w.blocks[size_t(n.child[c] + k / 4)];
+                const int32_t id = b.id[k % 4];
+                ASSERT_GE(id, 0);
+                ++seen[size_t(id)];
+                EXPECT_EQ(b.v[1][2][k % 4], t[size_t(id)].v1.z);
+            }
+            const TriangleBlock<4>& last = w.blocks[size_t(n.child[c] + nb - 1)];
+            for (int k = (n.count[c] - 1) % 4 + 1; k < 4; ++k) EXPECT_EQ(last.id[k], last.id[(n.count[c] - 1) % 4]);
+        }
+    for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i;
+}
+
+#define RTFACT_WIDE_DIRECT_TESTS(Name, Elem, elems, K, M)                                    \
+    TEST(WideBVH, Name##K##Single) {                                                         \
+        checkTraversal<Elem, K, 1, Make::M>(elems, true);                                    \
+        checkTraversal<Elem, K, 1, Make::M>(elems, false);                                   \
+    }                                                                                        \
+    TEST(WideBVH, Name##K##Native) {                                                         \
+        checkTraversal<Elem, K, simd::kNativeWidth, Make::M>(elems, true);                   \
+        checkTraversal<Elem, K, simd::kNativeWidth, Make::M>(elems, false);                  \
+    }                                                                                        \
+    TEST(WideBVH, Name##K##Packet64) { checkTraversal<Elem, K, 64, Make::M>(elems, false); } \
+    TEST(WideBVH, Name##K##Packet256) {                                                      \
+        checkTraversal<Elem, K, 256, Make::M>(elems, true);                                  \
+        checkTraversal<Elem, K, 256, Make::M>(elems, false);                                 \
+    }
+
+RTFACT_WIDE_DIRECT_TESTS(DirectSpheres, Sphere, testSpheres(2000), 8, Direct)
+RTFACT_WIDE_DIRECT_TESTS(DirectSpheres, Sphere, testSpheres(2000), 16, Direct)
+RTFACT_WIDE_DIRECT_TESTS(DirectTriangles, Triangle, testTriangles(), 8, Direct)
+RTFACT_WIDE_DIRECT_TESTS(Blocks4Triangles, Triangle, testTriangles(), 8, Blocks4)
+RTFACT_WIDE_DIRECT_TESTS(Blocks8Triangles, Triangle, testTriangles(), 8, Blocks8)
+RTFACT_WIDE_DIRECT_TESTS(Blocks4Triangles, Triangle, testTriangles(), 16, Blocks4)
 
 RTFACT_WIDE_TESTS(Spheres, Sphere, testSpheres(2000), 8)
 RTFACT_WIDE_TESTS(Spheres, Sphere, testSpheres(2000), 4)

@@ -1,0 +1,427 @@
+// WideSAHBVHBuilder: builds a K-wide BVH directly (no binary tree, no collapse pass).
+// Each node starts from one binned SAH split of its range and keeps splitting the child
+// with the largest surface area until it has K children, as Embree's medium-quality
+// builder does. Leaves are costed in whole blocks of `leafBlock` elements (the leaf
+// SIMD width: a leaf of 5 costs as much as one of 8 when blocks are 4 wide), a range of
+// at most one block is always a leaf, and the range stops being split once the block
+// cost of a leaf is no more than the split's. Works on bounds only, like every builder.
+//
+// Speed: references are 32 bytes (min and max in two SSE halves, the id in the spare
+// lane); small ranges use few bins (the bin clear and sweep would dominate); the top
+// levels bin and partition in parallel (private bins merged; out-of-place block
+// partition into a second buffer), and subtrees are built as parallel tasks.
+#pragma once
+#include <immintrin.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/task_group.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "core/accel/wide_bvh.h"
+#include "core/util/huge_pages.h"
+
+namespace rtfact {
+
+struct WideSAHBVHBuilder {
+    int leafBlock = 4;     // leaf SIMD block: ranges of at most this many are leaves
+    int maxLeafSize = 16;  // larger ranges are always split
+    float traversalCost = 1.0f;
+    float intersectionCost = 1.0f;  // per block of leafBlock elements
+
+    static constexpr int kMaxBins = 32;
+    static constexpr int kMaxDepth = 48;
+    static constexpr uint32_t kParallelSplit = 16384;  // parallel binning and partition above
+    static constexpr uint32_t kParallelTasks = 1024;   // subtrees as tasks above
+    static constexpr uint32_t kGrain = 4096;
+
+    template <int K>
+    void build(std::span<const AABB> bounds, WideBVHTopology<K>& out) const;
+
+   private:
+    struct alignas(16) Ref {
+        float lo[4];  // lo[3] holds the element id bits
+        float hi[4];
+    };
+    struct Box4 {
+        __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);
+        RTFACT_INLINE void extend(__m128 l, __m128 h) {
+            lo = _mm_min_ps(lo, l);
+            hi = _mm_max_ps(hi, h);
+        }
+        RTFACT_INLINE void extend(const Box4& b) { extend(b.lo, b.hi); }
+        RTFACT_INLINE void extend(const Ref& r) { extend(_mm_load_ps(r.lo), _mm_load_ps(r.hi)); }
+        RTFACT_INLINE void extendCentroid(const Ref& r) {
+            const __m128 c = _mm_add_ps(_mm_load_ps(r.lo), _mm_load_ps(r.hi));
+            extend(c, c);
+        }
+        // Half the surface area (the SAH only compares).
+        float halfArea() const {
+            alignas(16) float l[4], h[4];
+            _mm_store_ps(l, lo);
+            _mm_store_ps(h, hi);
+            const float dx = h[0] - l[0], dy = h[1] - l[1], dz = h[2] - l[2];
+            return dx < 0.0f ? 0.0f : dx * dy + dy * dz + dz * dx;
+        }
+        AABB aabb() const {
+            alignas(16) float l[4], h[4];
+            _mm_store_ps(l, lo);
+            _mm_store_ps(h, hi);
+            return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+        }
+    };
+    // A range of references, in buffer `buf` (0 or 1), with its bounds and the bounds of
+    // its doubled centroids.
+    struct Range {
+        uint32_t b = 0, e = 0;
+        int buf = 0;
+        Box4 box, cbox;
+        uint32_t size() const { return e - b; }
+    };
+    struct Split {
+        int axis = -1, pos = 0;  // left: bin index <= pos
+        float cost = kInf;       // sum over both sides of half area x blocks
+        __m128 cmin, scale;
+        int bins = 0;
+    };
+    struct Bins {
+        Box4 box[3][kMaxBins];
+        uint32_t count[3][kMaxBins];
+        int n;
+        explicit Bins(int nb) : n(nb) {
+            for (int a = 0; a < 3; ++a) std::fill(count[a], count[a] + nb, 0u);
+        }
+        void merge(const Bins& o) {
+            for (int a = 0; a < 3; ++a)
+                for (int k = 0; k < n; ++k) {
+                    box[a][k].extend(o.box[a][k]);
+                    count[a][k] += o.count[a][k];
+                }
+        }
+    };
+    struct Ctx {
+        Ref* buf[2];
+        uint32_t* order;
+        void* nodes;  // WideBVHNode<K>*
+        std::atomic<uint32_t> next{0};
+    };
+
+    static constexpr float kInf = std::numeric_limits<float>::infinity();
+
+    float blocks(uint32_t n) const { return float((n + uint32_t(leafBlock) - 1) / uint32_t(leafBlock)); }
+
+    static RTFACT_INLINE __m128i binOf(const Ref& r, __m128 cmin, __m128 scale, __m128i maxBin) {
+        const __m128 c = _mm_add_ps(_mm_load_ps(r.lo), _mm_load_ps(r.hi));
+        return _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, cmin), scale)), maxBin);
+    }
+
+    static void binRange(const Ref* refs, uint32_t b, uint32_t e, const Split& s, Bins& bins) {
+        const __m128i maxBin = _mm_set1_epi32(s.bins - 1);
+        alignas(16) int32_t k[4];
+        for (uint32_t i = b; i < e; ++i) {
+            const Ref& r = refs[i];
+            _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(r, s.cmin, s.scale, maxBin));
+            const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi);
+            for (int a = 0; a < 3; ++a) {
+                bins.count[a][k[a]]++;
+                bins.box[a][k[a]].extend(l, h);
+            }
+        }
+    }
+
+    Split findSplit(const Range& r, const Ref* refs) const {
+        Split s;
+        const uint32_t n = r.size();
+        const AABB cb = r.cbox.aabb();
+        const Vec3f ext = cb.extent();
+        if (!(maxComponent(ext) > 0.0f)) return s;
+        s.bins = std::min(kMaxBins, 4 + int(n / 20));
+        alignas(16) float sc[4] = {0, 0, 0, 0};
+        for (int a = 0; a < 3; ++a) sc[a] = ext[a] > 0.0f ? float(s.bins) * 0.99999f / ext[a] : 0.0f;
+        s.scale = _mm_load_ps(sc);
+        s.cmin = _mm_setr_ps(cb.lo.x, cb.lo.y, cb.lo.z, 0.0f);
+        Bins bins(s.bins);
+        if (n >= kParallelSplit) {
+            bins = tbb::parallel_reduce(
+                tbb::blocked_range<uint32_t>(r.b, r.e, kGrain), Bins(s.bins),
+                [&](const tbb::blocked_range<uint32_t>& br, Bins acc) {
+                    binRange(refs, br.begin(), br.end(), s, acc);
+                    return acc;
+                },
+                [](Bins x, const Bins& y) {
+                    x.merge(y);
+                    return x;
+                });
+        } else {
+            binRange(refs, r.b, r.e, s, bins);
+        }
+        // Sweep: right-to-left areas, then left-to-right costs, all in whole blocks.
+        for (int a = 0; a < 3; ++a) {
+            if (!(ext[a] > 0.0f)) continue;
+            float rightCost[kMaxBins];
+            Box4 acc;
+            uint32_t cnt = 0;
+            for (int k = s.bins - 1; k > 0; --k) {
+                acc.extend(bins.box[a][k]);
+                cnt += bins.count[a][k];
+                rightCost[k] = cnt ? acc.halfArea() * blocks(cnt) : -1.0f;
+            }
+            acc = Box4{};
+            cnt = 0;
+            for (int k = 0; k < s.bins - 1; ++k) {
+                acc.extend(bins.box[a][k]);
+                cnt += bins.count[a][k];
+                if (cnt == 0 || rightCost[k + 1] < 0.0f) continue;
+                const float cost = acc.halfArea() * blocks(cnt) + rightCost[k + 1];
+                if (cost < s.cost) {
+                    s.cost = cost;
+                    s.axis = a;
+                    s.pos = k;
+                }
+            }
+        }
+        return s;
+    }
+
+    // Splits r into l and rr (the references move to the children's buffers).
+    void partition(Ctx& ctx, const Range& r, const Split& s, Range& l, Range& rr) const {
+        Ref* src = ctx.buf[r.buf];
+        l = Range{};
+        rr = Range{};
+        const uint32_t n = r.size();
+        if (s.axis < 0) {
+            // No usable split (all centroids coincide): halve the range as it is.
+            const uint32_t mid = r.b + n / 2;
+            for (uint32_t i = r.b; i < r.e; ++i) {
+                Range& d = i < mid ? l : rr;
+                d.box.extend(src[i]);
+                d.cbox.extendCentroid(src[i]);
+            }
+            l.b = r.b, l.e = mid, rr.b = mid, rr.e = r.e;
+            l.buf = rr.buf = r.buf;
+            return;
+        }
+        alignas(16) float scl[4], cmn[4];
+        _mm_store_ps(scl, s.scale);
+        _mm_store_ps(cmn, s.cmin);
+        const int a = s.axis, pos = s.pos, maxBin = s.bins - 1;
+        const float sc = scl[a], cm = cmn[a];
+        auto left = [=](const Ref& x) { return std::min(int((x.lo[a] + x.hi[a] - cm) * sc), maxBin) <= pos; };
+        if (n < kParallelSplit) {
+            uint32_t i = r.b, j = r.e;
+            for (;;) {
+                while (i < j && left(src[i])) {
+                    l.box.extend(src[i]);
+                    l.cbox.extendCentroid(src[i]);
+                    ++i;
+                }
+                while (i < j && !left(src[j - 1])) {
+                    --j;
+                    rr.box.extend(src[j]);
+                    rr.cbox.extendCentroid(src[j]);
+                }
+                if (i >= j) break;
+                std::swap(src[i], src[j - 1]);
+            }
+            l.b = r.b, l.e = i, rr.b = i, rr.e = r.e;
+            l.buf = rr.buf = r.buf;
+            return;
+        }
+        // Out of place in parallel: count per block, then scatter into the other buffer.
+        Ref* dst = ctx.buf[1 - r.buf];
+        const uint32_t nb = (n + kGrain - 1) / kGrain;
+        struct BlockInfo {
+            uint32_t left;
+            Box4 lbox, lcbox, rbox, rcbox;
+        };
+        std::vector<BlockInfo> info(nb);
+        tbb::parallel_for(uint32_t(0), nb, [&](uint32_t bi) {
+            BlockInfo bl{};
+            bl.left = 0;
+            const uint32_t b = r.b + bi * kGrain, e = std::min(r.e, b + kGrain);
+            for (uint32_t i = b; i < e; ++i) {
+                if (left(src[i])) {
+                    ++bl.left;
+                    bl.lbox.extend(src[i]);
+                    bl.lcbox.extendCentroid(src[i]);
+                } else {
+                    bl.rbox.extend(src[i]);
+                    bl.rcbox.extendCentroid(src[i]);
+                }
+            }
+            info[bi] = bl;
+        });
+        uint32_t nl = 0;
+        std::vector<uint32_t> lofs(nb), rofs(nb);
+        for (uint32_t bi = 0; bi < nb; ++bi) {
+            lofs[bi] = nl;
+            nl += info[bi].left;
+            l.box.extend(info[bi].lbox);
+            l.cbox.extend(info[bi].lcbox);
+            rr.box.extend(info[bi].rbox);
+            rr.cbox.extend(info[bi].rcbox);
+        }
+        uint32_t nr = 0;
+        for (uint32_t bi = 0; bi < nb; ++bi) {
+            rofs[bi] = nr;
+            nr += std::min(kGrain, r.e - (r.b + bi * kGrain)) - info[bi].left;
+        }
+        tbb::parallel_for(uint32_t(0), nb, [&](uint32_t bi) {
+            uint32_t li = r.b + lofs[bi], ri = r.b + nl + rofs[bi];
+            const uint32_t b = r.b + bi * kGrain, e = std::min(r.e, b + kGrain);
+            for (uint32_t i = b; i < e; ++i) dst[left(src[i]) ? li++ : ri++] = src[i];
+        });
+        l.b = r.b, l.e = r.b + nl, rr.b = r.b + nl, rr.e = r.e;
+        l.buf = rr.buf = 1 - r.buf;
+    }
+
+    // Returns the child slot (node index, 0) or (first element, count) for range r.
+    template <int K>
+    std::pair<int32_t, int32_t> buildRange(Ctx& ctx, const Range& r, int depth) const {
+        const uint32_t n = r.size();
+        auto leaf = [&] {
+            const Ref* src = ctx.buf[r.buf];
+            for (uint32_t i = r.b; i < r.e; ++i) std::memcpy(&ctx.order[i], &src[i].lo[3], 4);
+            return std::pair<int32_t, int32_t>(int32_t(r.b), int32_t(n));
+        };
+        if (n <= uint32_t(leafBlock) || depth >= kMaxDepth) return leaf();
+        Split s = findSplit(r, ctx.buf[r.buf]);
+        const float area = r.box.halfArea();
+        if (n <= uint32_t(maxLeafSize) && s.axis >= 0 &&
+            intersectionCost * blocks(n) * area <= traversalCost * area + intersectionCost * s.cost)
+            return leaf();
+        if (s.axis < 0 && n <= uint32_t(maxLeafSize)) return leaf();
+
+        Range kids[K];
+        int cnt = 2;
+        partition(ctx, r, s, kids[0], kids[1]);
+        // Open the largest child until K children (Embree's widening rule).
+        while (cnt < K) {
+            int best = -1;
+            float bestArea = -1.0f;
+            for (int i = 0; i < cnt; ++i) {
+                if (kids[i].size() <= uint32_t(leafBlock)) continue;
+                const float a = kids[i].box.halfArea();
+                if (a > bestArea) bestArea = a, best = i;
+            }
+            if (best < 0) break;
+            const Range c = kids[best];
+            const Split cs = findSplit(c, ctx.buf[c.buf]);
+            partition(ctx, c, cs, kids[best], kids[cnt]);
+            ++cnt;
+        }
+        // Larger children first: any-hit rays meet the big occluders earlier.
+        float kidArea[K];
+        for (int i = 0; i < cnt; ++i) kidArea[i] = kids[i].box.halfArea();
+        for (int i = 1; i < cnt; ++i)
+            for (int j = i; j > 0 && kidArea[j - 1] < kidArea[j]; --j) {
+                std::swap(kidArea[j - 1], kidArea[j]);
+                std::swap(kids[j - 1], kids[j]);
+            }
+        const uint32_t ni = ctx.next.fetch_add(1, std::memory_order_relaxed);
+        auto* node = static_cast<WideBVHNode<K>*>(ctx.nodes) + ni;
+        std::pair<int32_t, int32_t> slot[K];
+        if (n >= kParallelTasks) {
+            tbb::task_group g;
+            for (int i = 0; i < cnt; ++i) g.run([&, i] { slot[i] = buildRange<K>(ctx, kids[i], depth + 1); });
+            g.wait();
+        } else {
+            for (int i = 0; i < cnt; ++i) slot[i] = buildRange<K>(ctx, kids[i], depth + 1);
+        }
+        for (int i = 0; i < K; ++i) {
+            if (i < cnt)
+                node->set(i, kids[i].box.aabb(), slot[i].first, slot[i].second);
+            else
+                node->clear(i);
+        }
+        return {int32_t(ni), 0};
+    }
+};
+
+template <int K>
+void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& out) const {
+    const uint32_t n = uint32_t(bounds.size());
+    out.nodes.clear();
+    out.order.clear();
+    out.box = AABB{};
+    if (n == 0) return;
+    // Two reference buffers (the parallel partition of the top levels goes from one to
+    // the other), first touched by the threads that fill them.
+    std::vector<Ref, UninitAllocator<Ref>> refs[2];
+    resizeHugePages(refs[0], n);
+    resizeHugePages(refs[1], n);
+    resizeHugePages(out.order, n);
+    // References and the root's bounds, in parallel.
+    struct Boxes {
+        Box4 box, cbox;
+    };
+    const Boxes root = tbb::parallel_reduce(
+        tbb::blocked_range<uint32_t>(0, n, kGrain), Boxes{},
+        [&](const tbb::blocked_range<uint32_t>& br, Boxes acc) {
+            for (uint32_t i = br.begin(); i != br.end(); ++i) {
+                Ref& r = refs[0][i];
+                r = {{bounds[i].lo.x, bounds[i].lo.y, bounds[i].lo.z, 0.0f},
+                     {bounds[i].hi.x, bounds[i].hi.y, bounds[i].hi.z, 0.0f}};
+                std::memcpy(&r.lo[3], &i, 4);
+                acc.box.extend(r);
+                acc.cbox.extendCentroid(r);
+            }
+            return acc;
+        },
+        [](Boxes x, const Boxes& y) {
+            x.box.extend(y.box);
+            x.cbox.extend(y.cbox);
+            return x;
+        });
+    // At most n - 1 inner nodes (each has two or more children); untouched pages of
+    // this upper bound cost nothing.
+    std::unique_ptr<WideBVHNode<K>[]> nodes(new WideBVHNode<K>[std::max<uint32_t>(n, 1)]);
+    Ctx ctx;
+    ctx.buf[0] = refs[0].data();
+    ctx.buf[1] = refs[1].data();
+    ctx.order = out.order.data();
+    ctx.nodes = nodes.get();
+    Range r;
+    r.b = 0, r.e = n, r.box = root.box, r.cbox = root.cbox;
+    out.box = root.box.aabb();
+    const auto top = buildRange<K>(ctx, r, 0);
+    if (top.second > 0) {
+        // A single leaf: a root with one leaf child.
+        resizeHugePages(out.nodes, 1);
+        out.nodes[0].set(0, out.box, top.first, top.second);
+        for (int i = 1; i < K; ++i) out.nodes[0].clear(i);
+        return;
+    }
+    // Depth-first order (children after their parent) for locality; the root is node 0.
+    resizeHugePages(out.nodes, ctx.next.load());
+    uint32_t used = 1;
+    std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, uint32_t(top.first)}};  // (new, old)
+    while (!stack.empty()) {
+        const auto [ni, oi] = stack.back();
+        stack.pop_back();
+        WideBVHNode<K>& dn = out.nodes[ni];
+        dn = nodes[oi];
+        // Siblings next to each other, the first child's subtree right after them.
+        for (int i = 0; i < K; ++i)
+            if (dn.child[i] >= 0 && !dn.isLeaf(i)) dn.child[i] = -2 - int32_t(used++);
+        for (int i = K - 1; i >= 0; --i)
+            if (dn.child[i] <= -2) {
+                const uint32_t nn = uint32_t(-2 - dn.child[i]);
+                stack.push_back({nn, uint32_t(nodes[oi].child[i])});
+                dn.child[i] = int32_t(nn);
+            }
+    }
+}
+
+static_assert(Builder<WideSAHBVHBuilder, WideBVHTopology<4>>);
+static_assert(Builder<WideSAHBVHBuilder, WideBVHTopology<8>>);
+static_assert(Builder<WideSAHBVHBuilder, WideBVHTopology<16>>);
+
+}  // namespace rtfact
