@@ -15,6 +15,7 @@
 #include <span>
 #include <vector>
 
+#include "core/accel/box4.h"
 #include "core/accel/bvh.h"
 #include "core/simd/native.h"
 #include "core/util/huge_pages.h"
@@ -35,27 +36,6 @@ struct InPlaceSAHBVHBuilder {
     struct alignas(16) Ref {
         float lo[4];
         float hi[4];
-    };
-    struct Box4 {
-        __m128 lo = _mm_set1_ps(kInfinityF), hi = _mm_set1_ps(-kInfinityF);
-        RTFACT_INLINE void extend(__m128 l, __m128 h) {
-            lo = _mm_min_ps(lo, l);
-            hi = _mm_max_ps(hi, h);
-        }
-        RTFACT_INLINE void extend(const Box4& b) { extend(b.lo, b.hi); }
-        float area() const {
-            alignas(16) float l[4], h[4];
-            _mm_store_ps(l, lo);
-            _mm_store_ps(h, hi);
-            const float dx = h[0] - l[0], dy = h[1] - l[1], dz = h[2] - l[2];
-            return dx < 0.0f ? 0.0f : 2.0f * (dx * dy + dy * dz + dz * dx);
-        }
-        AABB aabb() const {
-            alignas(16) float l[4], h[4];
-            _mm_store_ps(l, lo);
-            _mm_store_ps(h, hi);
-            return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
-        }
     };
     struct Ctx {
         Ref* refs;

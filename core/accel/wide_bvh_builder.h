@@ -25,6 +25,7 @@
 #include <span>
 #include <vector>
 
+#include "core/accel/box4.h"
 #include "core/accel/wide_bvh.h"
 #include "core/util/huge_pages.h"
 
@@ -50,33 +51,12 @@ struct WideSAHBVHBuilder {
         float lo[4];  // lo[3] holds the element id bits
         float hi[4];
     };
-    struct Box4 {
-        __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);
-        RTFACT_INLINE void extend(__m128 l, __m128 h) {
-            lo = _mm_min_ps(lo, l);
-            hi = _mm_max_ps(hi, h);
-        }
-        RTFACT_INLINE void extend(const Box4& b) { extend(b.lo, b.hi); }
-        RTFACT_INLINE void extend(const Ref& r) { extend(_mm_load_ps(r.lo), _mm_load_ps(r.hi)); }
-        RTFACT_INLINE void extendCentroid(const Ref& r) {
-            const __m128 c = _mm_add_ps(_mm_load_ps(r.lo), _mm_load_ps(r.hi));
-            extend(c, c);
-        }
-        // Half the surface area (the SAH only compares).
-        float halfArea() const {
-            alignas(16) float l[4], h[4];
-            _mm_store_ps(l, lo);
-            _mm_store_ps(h, hi);
-            const float dx = h[0] - l[0], dy = h[1] - l[1], dz = h[2] - l[2];
-            return dx < 0.0f ? 0.0f : dx * dy + dy * dz + dz * dx;
-        }
-        AABB aabb() const {
-            alignas(16) float l[4], h[4];
-            _mm_store_ps(l, lo);
-            _mm_store_ps(h, hi);
-            return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
-        }
-    };
+    // Adds a reference to a box and its doubled centroid to a centroid box.
+    static RTFACT_INLINE void extend(Box4& box, Box4& cbox, const Ref& r) {
+        const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi), c = _mm_add_ps(l, h);
+        box.extend(l, h);
+        cbox.extend(c, c);
+    }
     // A range of references, in buffer `buf` (0 or 1), with its bounds and the bounds of
     // its doubled centroids.
     struct Range {
@@ -201,8 +181,7 @@ struct WideSAHBVHBuilder {
             const uint32_t mid = r.b + n / 2;
             for (uint32_t i = r.b; i < r.e; ++i) {
                 Range& d = i < mid ? l : rr;
-                d.box.extend(src[i]);
-                d.cbox.extendCentroid(src[i]);
+                extend(d.box, d.cbox, src[i]);
             }
             l.b = r.b, l.e = mid, rr.b = mid, rr.e = r.e;
             l.buf = rr.buf = r.buf;
@@ -218,14 +197,12 @@ struct WideSAHBVHBuilder {
             uint32_t i = r.b, j = r.e;
             for (;;) {
                 while (i < j && left(src[i])) {
-                    l.box.extend(src[i]);
-                    l.cbox.extendCentroid(src[i]);
+                    extend(l.box, l.cbox, src[i]);
                     ++i;
                 }
                 while (i < j && !left(src[j - 1])) {
                     --j;
-                    rr.box.extend(src[j]);
-                    rr.cbox.extendCentroid(src[j]);
+                    extend(rr.box, rr.cbox, src[j]);
                 }
                 if (i >= j) break;
                 std::swap(src[i], src[j - 1]);
@@ -249,11 +226,9 @@ struct WideSAHBVHBuilder {
             for (uint32_t i = b; i < e; ++i) {
                 if (left(src[i])) {
                     ++bl.left;
-                    bl.lbox.extend(src[i]);
-                    bl.lcbox.extendCentroid(src[i]);
+                    extend(bl.lbox, bl.lcbox, src[i]);
                 } else {
-                    bl.rbox.extend(src[i]);
-                    bl.rcbox.extendCentroid(src[i]);
+                    extend(bl.rbox, bl.rcbox, src[i]);
                 }
             }
             info[bi] = bl;
@@ -370,8 +345,7 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
                 r = {{bounds[i].lo.x, bounds[i].lo.y, bounds[i].lo.z, 0.0f},
                      {bounds[i].hi.x, bounds[i].hi.y, bounds[i].hi.z, 0.0f}};
                 std::memcpy(&r.lo[3], &i, 4);
-                acc.box.extend(r);
-                acc.cbox.extendCentroid(r);
+                extend(acc.box, acc.cbox, r);
             }
             return acc;
         },

@@ -272,10 +272,13 @@ TEST(WideBVH, StructureTriangles) {
     checkStructure<8>(t);
     checkStructure<16>(t);
 }
-TEST(WideBVH, SingleElementAndEmpty) {
+// One sphere: a root with one leaf that a ray hits; no spheres: nothing is ever hit.
+template <class B>
+void checkSingleElementAndEmpty(const B& builder) {
     const std::vector<Sphere> one{{Vec3f(0.0f), 1.0f}};
-    const WideBVH<Sphere> w = buildWideBVH<Sphere>(SAHBVHBuilder{}, std::span<const Sphere>(one));
+    const WideBVH<Sphere> w = buildWideBVH<Sphere>(builder, std::span<const Sphere>(one));
     ASSERT_EQ(w.nodes.size(), 1u);
+    EXPECT_EQ(w.nodes[0].count[0], 1);
     RayPacket<1> r;
     r.setLane(0, Vec3f(0, 0, -5), Vec3f(0, 0, 1));
     r.finalize();
@@ -283,11 +286,13 @@ TEST(WideBVH, SingleElementAndEmpty) {
     WideBVHIntersector<SphereIntersector>{}.intersect<false, HitData::Shading>(w, r, h, Mask<1>(true));
     EXPECT_EQ(int32_t(h.id), 0);
     EXPECT_NEAR(float(h.t), 4.0f, 1e-5f);
-    const WideBVH<Sphere> none = buildWideBVH<Sphere>(SAHBVHBuilder{}, std::span<const Sphere>());
+    const WideBVH<Sphere> none = buildWideBVH<Sphere>(builder, std::span<const Sphere>());
+    EXPECT_TRUE(none.nodes.empty());
     WideBVHIntersector<SphereIntersector>{}.intersect<false, HitData::Shading>(none, r, h, Mask<1>(true));
     EXPECT_EQ(int32_t(h.id), -1);
     EXPECT_FALSE(WideBVHIntersector<SphereIntersector>{}.occluded<false>(none, r, Mask<1>(true))[0]);
 }
+TEST(WideBVH, SingleElementAndEmpty) { checkSingleElementAndEmpty(SAHBVHBuilder{}); }
 
 #define RTFACT_WIDE_TESTS(Name, Elem, elems, K)                    \
     TEST(WideBVH, Name##K##Single) {                               \
@@ -322,21 +327,7 @@ TEST(WideBVH, DirectStructureCoincident) {
     const std::vector<Sphere> same(100, Sphere{Vec3f(0.5f), 0.25f});
     checkDirectStructure<8>(same, 4);
 }
-TEST(WideBVH, DirectSingleElementAndEmpty) {
-    const std::vector<Sphere> one{{Vec3f(0.0f), 1.0f}};
-    const WideBVH<Sphere> w = buildWideBVH<Sphere>(WideSAHBVHBuilder{}, std::span<const Sphere>(one));
-    ASSERT_EQ(w.nodes.size(), 1u);
-    EXPECT_EQ(w.nodes[0].count[0], 1);
-    RayPacket<1> r;
-    r.setLane(0, Vec3f(0, 0, -5), Vec3f(0, 0, 1));
-    r.finalize();
-    SphereIntersector::Hit<1> h;
-    WideBVHIntersector<SphereIntersector>{}.intersect<false, HitData::Shading>(w, r, h, Mask<1>(true));
-    EXPECT_EQ(int32_t(h.id), 0);
-    const WideBVH<Sphere> none = buildWideBVH<Sphere>(WideSAHBVHBuilder{}, std::span<const Sphere>());
-    EXPECT_TRUE(none.nodes.empty());
-    EXPECT_FALSE(WideBVHIntersector<SphereIntersector>{}.occluded<false>(none, r, Mask<1>(true))[0]);
-}
+TEST(WideBVH, DirectSingleElementAndEmpty) { checkSingleElementAndEmpty(WideSAHBVHBuilder{}); }
 // Triangle blocks: every leaf's blocks hold exactly its triangles (ids), padded with
 // the last one.
 TEST(WideBVH, TriangleBlocksHoldLeafTriangles) {
