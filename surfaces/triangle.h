@@ -131,7 +131,6 @@ struct TriangleIntersector {
         using P = Packet<L>;
         const Vec3f of(ray.org.x[0], ray.org.y[0], ray.org.z[0]);
         const Vec3<L> d(Vec3f(ray.dir.x[0], ray.dir.y[0], ray.dir.z[0]));
-        const P zero(0.0f), inf(kInfinity);
         for (int base = 0; base < count; base += L) {
             const int n = std::min(L, count - base);
             Vec3<L> a, b, c;
@@ -141,26 +140,9 @@ struct TriangleIntersector {
                 b.setLane(i, t.v1 - of);
                 c.setLane(i, t.v2 - of);
             }
-            // Same values as the per-triangle test: n = (v1 - v0) x (v2 - v0).
-            const Vec3<L> nn = cross(b - a, c - a);
-            const P e0 = dot(triangleEdge(b, c), d), e1 = dot(triangleEdge(c, a), d), e2 = dot(triangleEdge(a, b), d);
-            const P nd = dot(nn, d);
-            const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
-            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != zero);
-            if (none(inside)) continue;
-            const P t = dot(nn, a) / nd;
-            const auto m = inside & (t > P(float(ray.tMin))) & (t < P(float(hit.t)));
-            if (none(m)) continue;
-            const P tm = select(m, t, inf);
-            const float best = hmin(tm);
-            const int lane = BitMask<L>(tm == P(best)).first();
-            hit.t = best;
-            hit.id = int32_t(ids[base + lane]);
-            if constexpr (D == HitData::Shading) {
-                const float inv = 1.0f / (e0[lane] + e1[lane] + e2[lane]);
-                hit.u = e1[lane] * inv;
-                hit.v = e2[lane] * inv;
-            }
+            P e0, e1, e2, t;
+            const auto m = laneTest(a, b, c, d, float(ray.tMin), float(hit.t), e0, e1, e2, t);
+            if (!none(m)) takeNearest<D>(m, t, e0, e1, e2, ids + base, hit);
         }
     }
 
@@ -169,22 +151,10 @@ struct TriangleIntersector {
     template <HitData D, int L>
     RTFACT_INLINE void intersectBlocks(const TriangleBlock<L>* blocks, int n, const RayPacket<1>& ray,
                                        Hit<1>& hit) const {
-        using P = Packet<L>;
-        const P inf(kInfinity);
         for (int k = 0; k < n; ++k) {
-            P e0, e1, e2, t;
+            Packet<L> e0, e1, e2, t;
             const auto m = blockTest(blocks[k], ray, float(hit.t), e0, e1, e2, t);
-            if (none(m)) continue;
-            const P tm = select(m, t, inf);
-            const float best = hmin(tm);
-            const int lane = BitMask<L>(tm == P(best)).first();
-            hit.t = best;
-            hit.id = blocks[k].id[lane];
-            if constexpr (D == HitData::Shading) {
-                const float inv = 1.0f / (e0[lane] + e1[lane] + e2[lane]);
-                hit.u = e1[lane] * inv;
-                hit.v = e2[lane] * inv;
-            }
+            if (!none(m)) takeNearest<D>(m, t, e0, e1, e2, blocks[k].id, hit);
         }
     }
     // Any hit in (tMin, hit.t): records it in hit and returns true.
@@ -214,16 +184,42 @@ struct TriangleIntersector {
         const Vec3<L> a(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
         const Vec3<L> bb(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
         const Vec3<L> c(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
+        return laneTest(a, bb, c, d, float(ray.tMin), tFar, e0, e1, e2, t);
+    }
+    // One ray against L triangles given relative to the ray origin (a, b, c): the same
+    // watertight edge functions as the per-triangle test; the lanes hit in (tMin, tFar).
+    // t is computed only when some lane is inside.
+    template <int L>
+    static RTFACT_INLINE auto laneTest(const Vec3<L>& a, const Vec3<L>& b, const Vec3<L>& c, const Vec3<L>& d,
+                                       float tMin, float tFar, Packet<L>& e0, Packet<L>& e1, Packet<L>& e2,
+                                       Packet<L>& t) {
+        using P = Packet<L>;
         // Same values as the per-triangle test: n = (v1 - v0) x (v2 - v0).
-        const Vec3<L> nn = cross(bb - a, c - a);
-        e0 = dot(triangleEdge(bb, c), d);
+        const Vec3<L> nn = cross(b - a, c - a);
+        e0 = dot(triangleEdge(b, c), d);
         e1 = dot(triangleEdge(c, a), d);
-        e2 = dot(triangleEdge(a, bb), d);
+        e2 = dot(triangleEdge(a, b), d);
         const P nd = dot(nn, d);
         const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
         const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != P(0.0f));
+        if (none(inside)) return inside;
         t = dot(nn, a) / nd;
-        return inside & (t > P(float(ray.tMin))) & (t < P(tFar));
+        return inside & (t > P(tMin)) & (t < P(tFar));
+    }
+    // Records the nearest lane of mask m (not empty) in hit; ids[lane] is its triangle.
+    template <HitData D, int L, class Mk, class Id>
+    static RTFACT_INLINE void takeNearest(const Mk& m, const Packet<L>& t, const Packet<L>& e0, const Packet<L>& e1,
+                                          const Packet<L>& e2, const Id* ids, Hit<1>& hit) {
+        const Packet<L> tm = select(m, t, Packet<L>(kInfinity));
+        const float best = hmin(tm);
+        const int lane = BitMask<L>(tm == Packet<L>(best)).first();
+        hit.t = best;
+        hit.id = int32_t(ids[lane]);
+        if constexpr (D == HitData::Shading) {
+            const float inv = 1.0f / (e0[lane] + e1[lane] + e2[lane]);
+            hit.u = e1[lane] * inv;
+            hit.v = e2[lane] * inv;
+        }
     }
 };
 static_assert(ElementIntersector<TriangleIntersector, Triangle>);
