@@ -1,6 +1,6 @@
 // rtfact-bench volume FILE: RTfact's packet DVR against two peers on the same volume,
 // transfer function, view, step size (in voxels) and thread count, in one process:
-// VTK's vtkFixedPointVolumeRayCastMapper (bench_vtk_volume.h; under xvfb-run when there
+// VTK's vtkFixedPointVolumeRayCastMapper (bench_vtk_volume.h; on a private Xvfb when there
 // is no DISPLAY) and OpenVDB's ray marcher. Image quality: PSNR of each frame against
 // RTfact at a fine step (--ref-step) with the same transfer function. The OpenVDB peer
 // is the primary-ray part of openvdb::tools::VolumeRender: a VolumeRayIntersector
@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <thread>
 
 #include "bench/bench_commands.h"
@@ -176,15 +177,16 @@ int benchVolume(int argc, char** argv) {
         "--images", outPrefix,
         "Write PREFIX_rtfact.png, PREFIX_vtk.png (and _vtk_cast.png), PREFIX_openvdb.png and PREFIX_reference.png");
     app.add_flag("--no-peer", skipPeer, "Only RTfact (no VTK, no OpenVDB)");
-    app.add_flag("--no-vtk", skipVtk, "Leave out the VTK peer (it needs an X server: xvfb-run)");
+    app.add_flag("--no-vtk", skipVtk, "Leave out the VTK peer (it needs an X server: Xvfb without DISPLAY)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
     const bool runVtk = !skipPeer && !skipVtk, runVdb = !skipPeer && mode == "dvr";
-    // VTK's render window needs X: without DISPLAY, this run continues under xvfb-run.
-    if (runVtk) requireDisplayOrReexec(argc, argv);
+    // VTK's render window needs X: without DISPLAY, a private Xvfb for this run.
+    std::optional<VirtualDisplay> display;
+    if (runVtk) display.emplace(argc, argv);
     if (!outPrefix.empty()) checkImageWritable(outPrefix + "_rtfact.png");  // fail before rendering
     int w = 0, h = 0;
     if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 1 || h < 1) throw Error("--size", "expected WxH");

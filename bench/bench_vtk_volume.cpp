@@ -1,6 +1,12 @@
 #include "bench/bench_vtk_volume.h"
 
 #include <X11/Xlib.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
@@ -24,9 +30,11 @@
 #include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <random>
 
 #include "bench/bench_common.h"
 #include "core/render/srgb.h"
@@ -96,7 +104,7 @@ VtkVolumePeer::VtkVolumePeer(const VtkVolumeView& view) : impl_(std::make_unique
     m.h = view.height;
     if (!displayReachable())
         throw Error("VTK", std::string("cannot open the X display '") + displayName() +
-                               "' (VTK's render window needs one; run under xvfb-run -a)");
+                               "' (VTK's render window needs one; unset DISPLAY to get a virtual one)");
 
     // Stored values with the volume's spacing and origin: voxel (i,j,k) sits at
     // origin + (i,j,k) * spacing for both renderers.
@@ -252,35 +260,113 @@ std::vector<float> VtkVolumePeer::image() {
     return out;
 }
 
-void requireDisplayOrReexec(int argc, char** argv) {
+namespace {
+
+enum class XvfbStart { Ready, Missing, Failed, Timeout };
+
+// Starts `Xvfb :display` and waits until it accepts connections (it writes its display
+// number to -displayfd then). `pid` is the server's on Ready, -1 otherwise.
+XvfbStart startXvfb(int display, int& pid) {
+    pid = -1;
+    int fds[2];
+    if (pipe2(fds, O_CLOEXEC) != 0) return XvfbStart::Failed;
+    const pid_t child = fork();
+    if (child < 0) {
+        close(fds[0]);
+        close(fds[1]);
+        return XvfbStart::Failed;
+    }
+    if (child == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGTERM);  // never outlive the benchmark
+        dup2(fds[1], 3);                   // dup2 clears close-on-exec on fd 3
+        const int quiet = open("/dev/null", O_WRONLY);
+        if (quiet >= 0) dup2(quiet, 2);
+        const std::string name = ":" + std::to_string(display);
+        execlp("Xvfb", "Xvfb", name.c_str(), "-displayfd", "3", "-nolisten", "tcp", "-noreset", "-screen", "0",
+               "1280x1024x24", static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    close(fds[1]);
+    std::string said;
+    pollfd pfd{fds[0], POLLIN, 0};
+    bool timedOut = false;
+    while (said.find('\n') == std::string::npos) {
+        if (poll(&pfd, 1, 30000) <= 0) {
+            timedOut = true;
+            break;
+        }
+        char buf[16];
+        const ssize_t n = read(fds[0], buf, sizeof buf);
+        if (n <= 0) break;  // the server exited
+        said.append(buf, size_t(n));
+    }
+    close(fds[0]);
+    if (said.find('\n') != std::string::npos) {
+        pid = child;
+        return XvfbStart::Ready;
+    }
+    int status = 0;
+    kill(child, SIGTERM);
+    waitpid(child, &status, 0);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return XvfbStart::Missing;
+    return timedOut ? XvfbStart::Timeout : XvfbStart::Failed;
+}
+
+bool displayInUse(int display) {
+    const std::string n = std::to_string(display);
+    return access(("/tmp/.X" + n + "-lock").c_str(), F_OK) == 0 || access(("/tmp/.X11-unix/X" + n).c_str(), F_OK) == 0;
+}
+
+}  // namespace
+
+VirtualDisplay::VirtualDisplay(int argc, char** argv) {
     const char* display = std::getenv("DISPLAY");
     if (display && *display) return;
     std::string cmd = "xvfb-run -a rtfact-bench";
-    for (int i = 0; i < argc; ++i) cmd += std::string(" ") + argv[i];
-    if (std::getenv("RTFACT_BENCH_UNDER_XVFB"))
-        throw Error("VTK", "still no DISPLAY under xvfb-run; run `" + cmd + "` by hand, or pass --no-vtk");
-    char self[4096];
-    const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-    if (n <= 0) throw Error("VTK", "no DISPLAY for VTK's render window; run `" + cmd + "`, or pass --no-vtk");
-    self[n] = 0;
-    std::vector<char*> args;
-    // -a takes the first free server number from -n on; starting from one of our own
-    // makes two benchmarks started at once less likely to race for the same display.
-    std::string from = std::to_string(100 + getpid() % 800);
-    char xvfb[] = "xvfb-run", autoNum[] = "-a", num[] = "-n";
-    args.push_back(xvfb);
-    args.push_back(autoNum);
-    args.push_back(num);
-    args.push_back(from.data());
-    args.push_back(self);
-    for (int i = 0; i < argc; ++i) args.push_back(argv[i]);
-    args.push_back(nullptr);
-    std::fprintf(stderr, "rtfact-bench: no DISPLAY: running again under `xvfb-run -a` for VTK's render window\n");
-    std::fflush(stdout);
-    setenv("RTFACT_BENCH_UNDER_XVFB", "1", 1);
-    execvp(args[0], args.data());
-    throw Error("VTK", "no DISPLAY and xvfb-run is not installed (apt-get install xvfb xauth); run `" + cmd +
-                           "` on a machine with it, or pass --no-vtk");
+    for (int i = 0; i < argc; ++i) cmd += std::string(" ") + argv[i];  // argv[0] is "volume"
+    const std::string hint = "; run `" + cmd + "`, or pass --no-vtk";
+    // -noreset: an X server resets when its last client leaves and refuses connections
+    // meanwhile; our probe's connection closing right before VTK's made VTK abort now and
+    // then (also under xvfb-run). Servers are started one at a time under an exclusive
+    // lock, each on a display no lock or socket file claims, drawn at random far above
+    // the usual ones, so concurrent benchmarks never race for a number.
+    const int lock = open("/tmp/.rtfact-xvfb.lock", O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (lock >= 0) flock(lock, LOCK_EX);
+    struct Unlock {
+        int fd;
+        ~Unlock() {
+            if (fd >= 0) close(fd);  // releases the lock
+        }
+    } unlock{lock};
+    std::mt19937 random(unsigned(getpid()) ^ unsigned(std::chrono::steady_clock::now().time_since_epoch().count()));
+    std::uniform_int_distribution<int> pick(1000, 29999);
+    for (int attempt = 0; attempt < 20; ++attempt) {
+        const int number = pick(random);
+        if (displayInUse(number)) continue;
+        switch (startXvfb(number, pid_)) {
+            case XvfbStart::Ready: {
+                setenv("DISPLAY", (":" + std::to_string(number)).c_str(), 1);
+                std::fprintf(stderr,
+                             "rtfact-bench: no DISPLAY: VTK's render window goes to a virtual X server (Xvfb :%d)\n",
+                             number);
+                return;
+            }
+            case XvfbStart::Missing:
+                throw Error("VTK", "no DISPLAY and Xvfb is not installed (apt-get install xvfb)" + hint);
+            case XvfbStart::Timeout:
+                throw Error("VTK", "no DISPLAY and Xvfb did not start within 30 s" + hint);
+            case XvfbStart::Failed:
+                break;  // taken meanwhile by a server we do not know of: draw again
+        }
+    }
+    throw Error("VTK", "no DISPLAY and Xvfb failed to start on 20 free-looking displays" + hint);
+}
+
+VirtualDisplay::~VirtualDisplay() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGTERM);
+    waitpid(pid_, nullptr, 0);
+    unsetenv("DISPLAY");
 }
 
 }  // namespace rtfact::bench

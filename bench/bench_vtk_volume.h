@@ -7,7 +7,7 @@
 // thread count. VTK headers stay in the .cpp: they are slow to compile.
 //
 // VTK's render window needs an X server (Debian's VTK 9.1 has no EGL/OSMesa build):
-// without DISPLAY, `reexecUnderXvfb` runs the whole benchmark again under `xvfb-run -a`.
+// without DISPLAY, `VirtualDisplay` starts Xvfb for the run.
 #pragma once
 #include <memory>
 #include <string>
@@ -57,9 +57,19 @@ class VtkVolumePeer {
     std::unique_ptr<Impl> impl_;
 };
 
-// When DISPLAY is unset: execs `xvfb-run -a <this program> <args>` (never returns on
-// success); throws rtfact::Error with the exact command to run when xvfb-run is missing
-// or the re-run still has no display. Returns when a display is set.
-void requireDisplayOrReexec(int argc, char** argv);
+// When DISPLAY is unset: starts a private Xvfb (the server picks a free display itself)
+// and sets DISPLAY for this process until destroyed. Throws rtfact::Error naming the
+// command to run by hand when Xvfb is missing or does not start. Does nothing when
+// DISPLAY is set.
+class VirtualDisplay {
+   public:
+    VirtualDisplay(int argc, char** argv);
+    ~VirtualDisplay();
+    VirtualDisplay(const VirtualDisplay&) = delete;
+    VirtualDisplay& operator=(const VirtualDisplay&) = delete;
+
+   private:
+    int pid_ = -1;
+};
 
 }  // namespace rtfact::bench
