@@ -45,6 +45,18 @@ float edlStrength(const SceneData& d, const Settings& s) {
 
 }  // namespace detail
 
+float eyeDomeStrength(const Scene& scene, const Settings& settings) {
+    if (!scene.data) throw UsageError("scene", "no scene");
+    return detail::edlStrength(*scene.data, settings);
+}
+
+void applyEyeDomeLighting(Frame& frame, float strength) {
+    if (strength <= 0) return;
+    if (frame.depth.size() != size_t(frame.width) * size_t(frame.height) || frame.rgba.size() != frame.depth.size() * 4)
+        throw UsageError("frame", "eye-dome lighting needs the frame's depth (FrameOptions::depth)");
+    ::rtfact::applyEyeDomeLighting(frame.rgba, frame.depth, frame.width, frame.height, strength);
+}
+
 int defaultPacketSize(SceneKind kind) { return kind == SceneKind::Points ? 16 : 64; }
 
 CameraFrame fitCamera(const DefaultView& view, float fovDeg, float aspect) {
@@ -134,7 +146,7 @@ PassResult RenderSession::renderSamples(int n) {
     const int w = std::max(1, opts_.width / scale), h = std::max(1, opts_.height / scale);
     {
         std::lock_guard l(state_);
-        const bool edl = detail::edlStrength(data, settings) > 0;
+        const bool edl = detail::edlStrength(data, settings) > 0 || opts_.depth;
         const bool resize = !first_ || first_->width() != w || first_->height() != h || first_->hasDepth() != edl;
         if (resize) {
             first_.reset();
@@ -215,9 +227,11 @@ Frame RenderSession::frame() const {
         f.rgba.resize(sum_.size());
         for (size_t i = 0; i < sum_.size(); ++i) f.rgba[i] = sum_[i] * inv;
     }
+    if (opts_.depth) f.depth = first_->depth();
     // The depth of the last pass shades the averaged colours.
-    if (samples_ > 0 && first_->hasDepth())
-        applyEyeDomeLighting(f.rgba, first_->depth(), f.width, f.height, detail::edlStrength(*scene_.data, settings_));
+    const float edl = detail::edlStrength(*scene_.data, settings_);
+    if (samples_ > 0 && first_->hasDepth() && edl > 0)
+        ::rtfact::applyEyeDomeLighting(f.rgba, first_->depth(), f.width, f.height, edl);
     return f;
 }
 

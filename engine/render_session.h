@@ -32,6 +32,9 @@ struct FrameOptions {
     // Renders only the tiles this source hands out (RenderOptions::nextTile; the other
     // pixels stay empty): the MPI image-parallel mode's ranks share one image this way.
     std::function<int()> nextTile;
+    // Frame::depth is filled: the nearest hit per pixel (+inf where nothing was hit), so that
+    // parts rendered apart can be depth-composited (docs/mpi.md).
+    bool depth = false;
 };
 
 // Rays per packet that measured best for each kind (sub-pixel splats make wide point
@@ -51,7 +54,15 @@ struct PassResult {
 struct Frame {
     int width = 0, height = 0, samples = 0;
     std::vector<float> rgba;
+    std::vector<float> depth;  // with FrameOptions::depth: width x height, the minimum over the samples
 };
+
+// Eye-dome lighting strength a render of `scene` with `settings` applies (0: none): point
+// clouds only; --edl, else on for clouds whose file had no normals.
+float eyeDomeStrength(const Scene& scene, const Settings& settings);
+// Applies eye-dome lighting to `frame` from its depth (FrameOptions::depth), as a render
+// does: for images composited from parts rendered without it (Settings' points.edl = 0).
+void applyEyeDomeLighting(Frame& frame, float strength);
 
 class RenderSession {
    public:

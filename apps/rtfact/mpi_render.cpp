@@ -65,15 +65,15 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
     if (root && !c.quiet)
         std::fprintf(stderr, "rtfact: mpi: %d ranks, --distribute image (every rank holds the scene)%s\n", mpi.size,
                      c.distribute.empty() ? ", chosen: the data fits every rank" : "");
-    // Eye-dome lighting filters the whole depth image, which no rank holds: rendered
-    // without it (the same on every rank) until the depth is gathered too.
-    if (job.scene.kind() == engine::SceneKind::Points &&
-        (job.settings.points.edl ? *job.settings.points.edl > 0 : job.scene.info().get("normals") == "none")) {
-        if (root && !c.quiet)
-            std::fprintf(stderr,
-                         "rtfact: warning: eye-dome lighting is not applied under mpirun yet: rendering without it\n");
+    // Eye-dome lighting filters the whole depth image, which no rank holds: the ranks
+    // render without it and hand in their tiles' depth; rank 0 applies it to the assembled
+    // image, as one process applies it to its own.
+    const float edl = engine::eyeDomeStrength(job.scene, job.settings);
+    if (edl > 0) {
         job.settings.points.edl = 0.0f;
+        job.frame.depth = true;
     }
+    const size_t ch = edl > 0 ? 5 : 4;  // floats per pixel gathered: RGBA (and depth)
 
     const TileGrid grid(c.width, c.height, RenderOptions{}.tileSize);
     const int tiles = grid.count();
@@ -168,10 +168,12 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
     std::vector<float> pixels;
     for (int t : myTiles) {
         const Region r = grid.region(t);
-        for (int y = r.y0; y < r.y1; ++y) {
-            const float* row = image.rgba.data() + (size_t(y) * size_t(grid.width) + size_t(r.x0)) * 4;
-            pixels.insert(pixels.end(), row, row + size_t(r.x1 - r.x0) * 4);
-        }
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) {
+                const size_t i = size_t(y) * size_t(grid.width) + size_t(x);
+                pixels.insert(pixels.end(), image.rgba.data() + i * 4, image.rgba.data() + i * 4 + 4);
+                if (ch == 5) pixels.push_back(image.depth[i]);
+            }
     }
     if (!root) mine.bytes += double(myTiles.size() * sizeof(int) + pixels.size() * sizeof(float));
     const Outcome gathered = attempt([&] {
@@ -190,7 +192,7 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
             floatOffsets[r] = floats;
             for (int k = 0; k < counts[r]; ++k, ++i) {
                 const Region reg = grid.region(tileOf[i]);
-                floatCounts[r] += (reg.x1 - reg.x0) * (reg.y1 - reg.y0) * 4;
+                floatCounts[r] += (reg.x1 - reg.x0) * (reg.y1 - reg.y0) * int(ch);
             }
             floats += floatCounts[r];
         }
@@ -202,11 +204,12 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
         const float* p = received.data();
         for (int t : tileOf) {
             const Region r = grid.region(t);
-            for (int y = r.y0; y < r.y1; ++y) {
-                float* row = image.rgba.data() + (size_t(y) * size_t(grid.width) + size_t(r.x0)) * 4;
-                std::copy(p, p + size_t(r.x1 - r.x0) * 4, row);
-                p += size_t(r.x1 - r.x0) * 4;
-            }
+            for (int y = r.y0; y < r.y1; ++y)
+                for (int x = r.x0; x < r.x1; ++x, p += ch) {
+                    const size_t i = size_t(y) * size_t(grid.width) + size_t(x);
+                    std::copy(p, p + 4, image.rgba.data() + i * 4);
+                    if (ch == 5) image.depth[i] = p[4];
+                }
         }
     });
     // A failure here leaves the others inside a collective: end them all.
@@ -218,7 +221,10 @@ int runMpiRender(CommonOptions& c, const std::function<engine::Settings()>& sett
     MPI_Gather(figures, 4, MPI_DOUBLE, all.data(), 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     if (!root) return 0;
 
-    const Outcome written = attempt([&] { writeImage(c.out, image.width, image.height, image.rgba); });
+    const Outcome written = attempt([&] {
+        engine::applyEyeDomeLighting(image, edl);
+        writeImage(c.out, image.width, image.height, image.rgba);
+    });
     if (written.status) {
         std::fprintf(stderr, "rtfact: error: rank 0: %s\n", written.message.c_str());
         return written.status;

@@ -28,8 +28,8 @@ fail() {
 # Small, uneven sizes (partial tiles), two samples per pixel (accumulation order).
 common=(--size 150x97 --spp 2 --threads 1 --quiet)
 case "$scene" in
-  # EDL (on by default for this scan) is not applied under mpirun yet (docs/mpi.md).
-  points) args=(points "$data/points/bunny_bun000.ply" --edl 0) ;;
+  # EDL is on by default for this scan: rank 0 applies it to the gathered depth.
+  points) args=(points "$data/points/bunny_bun000.ply") ;;
   volume) args=(volume "$data/volumes/tooth_103x94x161_uint8.mhd") ;;
   mesh) args=(mesh "$data/meshes/bunny.ply") ;;
   spheres) args=(spheres) ;;
