@@ -48,6 +48,10 @@ void applyLoadFilter(PointCloud& c, const LoadFilter& filter, const std::string&
     }
     if (kept == 0) throw Error(file, "no point passes --classes/--returns/--crop (of " + std::to_string(n) + ")");
     if (kept == n) return;
+    keepPoints(c, keep);
+}
+
+void keepPoints(PointCloud& c, const std::vector<uint8_t>& keep) {
     compact(c.positions, keep);
     compact(c.normals, keep);
     compact(c.colors, keep);

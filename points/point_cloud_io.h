@@ -26,6 +26,8 @@ PointCloud loadPointCloud(const std::string& file, const LoadFilter& filter = {}
 // Keeps the points that pass `filter` (every per-point array follows); throws
 // Error(file, ...) when the filter needs an attribute the cloud lacks or nothing is left.
 void applyLoadFilter(PointCloud& cloud, const LoadFilter& filter, const std::string& file);
+// Keeps the points i with keep[i] != 0, in order, in all of the cloud's arrays (freeing the rest).
+void keepPoints(PointCloud& cloud, const std::vector<uint8_t>& keep);
 // LAS 1.0-1.4 (formats 0-10) and LAZ; `threads` decode in parallel (0: all cores).
 PointCloud loadLas(const std::string& file, const LoadFilter& filter = {}, int threads = 0);
 // What a loaded cloud lost, as one line for a warning: "FILE: 12 points with non-finite

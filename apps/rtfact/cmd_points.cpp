@@ -30,16 +30,18 @@ void addPointsCommand(CLI::App& app, CommandList& list) {
     cmd->add_option("FILE", o->file, "Point cloud file (.ply .pcd .xyz .pts .las .laz)")->required();
     o->points.addTo(*cmd);
     list.push_back({cmd, [o] {
+                        auto options = [&] {
+                            engine::OpenOptions oo;
+                            oo.kind = engine::SceneKind::Points;
+                            oo.progress = !o->common.quiet;
+                            oo.keepSource = false;
+                            oo.points = o->points.loadFilter();
+                            return oo;
+                        };
+                        const DataSource data{engine::SceneKind::Points, o->file, options};
                         return runRenderCommand(
                             o->common, [&] { return o->points.toSettings(); },
-                            [&] {
-                                engine::OpenOptions oo;
-                                oo.kind = engine::SceneKind::Points;
-                                oo.progress = !o->common.quiet;
-                                oo.keepSource = false;
-                                oo.points = o->points.loadFilter();
-                                return engine::open({o->file}, oo);
-                            });
+                            [&] { return engine::open({o->file}, options()); }, &data);
                     }});
 }
 

@@ -9,11 +9,14 @@
 #include <vector>
 
 #include "core/render/image_io.h"
+#include "distributed/point_parts.h"
 #include "distributed/sort_last_compositor.h"
 #include "distributed/volume_parts.h"
 #include "engine/render_session.h"
 #include "engine/stats.h"
 #include "engine/volume_part.h"
+#include "points/point_cloud_io.h"
+#include "points/point_prepare.h"
 
 namespace rtfact::app {
 
@@ -45,26 +48,40 @@ uint64_t dataBytes(const std::string& file) {
     return n;
 }
 
-// The rank figures of --stats, gathered on rank 0.
-enum Figure { kLoadMs, kRenderMs, kCompositeMs, kBytes, kLoaded, kHwm, kFigures };
+// The rank figures of --stats, gathered on rank 0 (kLoaded: voxel bytes or points owned).
+enum Figure { kLoadMs, kRenderMs, kCompositeMs, kBytes, kLoaded, kHwm, kGhosts, kFigures };
+
+int runMpiPointData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine::Settings()>& settings,
+                    const DataSource& data);
 
 }  // namespace
 
 std::string chooseDistribution(const CommonOptions& c, const DataSource* data, int ranks) {
-    if (c.distribute == "data" && (!data || data->kind != engine::SceneKind::Volume))
-        throw engine::UsageError("--distribute", "data: data-parallel rendering is for volumes (rtfact volume)");
+    if (c.distribute == "data" && !data)
+        throw engine::UsageError("--distribute",
+                                 "data: data-parallel rendering is for volumes and point clouds (rtfact volume, "
+                                 "rtfact points)");
     if (!c.distribute.empty()) return c.distribute;
-    if (!data || data->kind != engine::SceneKind::Volume) return "image";
-    // Image-parallel holds the dense volume and its bricks while loading on every rank of
-    // this node: about twice the voxel bytes each.
+    if (!data) return "image";
+    // Image-parallel holds the whole data on every rank of this node: a volume dense and
+    // bricked while loading (about twice the voxel bytes), a cloud while it is prepared
+    // and its tree built (the engine's calibrated peak, estimating normals and radii).
+    uint64_t perRank = 0;
+    if (data->kind == engine::SceneKind::Volume) {
+        perRank = 2 * dataBytes(data->file);
+    } else {
+        const auto probe = points::probePointFile(data->file);
+        perRank = probe ? points::pointPipelineBytes(probe->points, true, true) : 0;
+    }
     const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
     const uint64_t perNode = uint64_t(std::max(1, local ? std::atoi(local) : ranks));
     const uint64_t avail = procKb("/proc/meminfo", "MemAvailable") * 1024;
-    return avail == 0 || 2 * dataBytes(data->file) * perNode <= avail ? "image" : "data";
+    return avail == 0 || perRank * perNode <= avail ? "image" : "data";
 }
 
 int runMpiData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine::Settings()>& settings,
                const DataSource& data) {
+    if (data.kind == engine::SceneKind::Points) return runMpiPointData(mpi, c, settings, data);
     const bool root = mpi.rank == 0;
     if (!root) c.quiet = true;
     engine::Settings s;
@@ -170,5 +187,131 @@ int runMpiData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine
     }
     return 0;
 }
+
+namespace {
+
+// Point clouds: each rank renders the discs whose centres lie in its cell, with the depth;
+// the ranks keep the nearest hit per pixel, and rank 0 applies eye-dome lighting to the
+// composited image from the composited depth.
+int runMpiPointData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine::Settings()>& settings,
+                    const DataSource& data) {
+    const bool root = mpi.rank == 0;
+    if (!root) c.quiet = true;
+    engine::Settings s;
+    distributed::PointPart part;
+    double fig[kFigures] = {};
+    if (int st = mpi.agree(attempt([&] {
+            c.finalize();
+            s = settings();
+            // Lights placed from the cloud's box (direct, whitted) and rays that meet other
+            // parts' points (ao, path) need the whole cloud.
+            if (s.points.integrator != "eyelight")
+                throw engine::UsageError("--integrator", s.points.integrator +
+                                                             ": --distribute data renders point clouds with eyelight; "
+                                                             "use --distribute image");
+            if (root) checkImageWritable(c.out);
+        })))
+        return st;
+    if (int st = mpi.agree(attempt([&] {
+            engine::OpenOptions o = data.options();
+            o.progress = false;  // every rank reads the file: no bars over each other
+            part = distributed::loadPointPart(data.file, o, s, mpi.rank, mpi.size);
+        })))
+        return st;
+    fig[kLoadMs] = part.loadMs;
+    fig[kLoaded] = double(part.owned);
+    fig[kGhosts] = double(part.ghosts);
+    if (root && !c.quiet) {
+        std::fprintf(stderr,
+                     "rtfact: mpi: %d ranks, --distribute data (each rank keeps the points of one cell along %c; "
+                     "the file is read whole and cut)%s\n",
+                     mpi.size, "xyz"[part.axis],
+                     c.distribute.empty() ? ", chosen: the cloud does not fit every rank" : "");
+        for (const std::string& w : part.warnings) std::fprintf(stderr, "rtfact: warning: %s\n", w.c_str());
+    }
+
+    const CameraFrame camera = c.frame(part.view.focus, part.view.viewDir, part.view.up);
+    const auto r0 = std::chrono::steady_clock::now();
+    engine::Frame image;
+    if (int st = mpi.agree(attempt([&] {
+            engine::Settings ps;
+            const engine::Scene scene = distributed::preparePointPart(part, camera.eye, ps);
+            engine::FrameOptions frame;
+            frame.width = c.width;
+            frame.height = c.height;
+            frame.packet = c.packet;
+            frame.threads = c.threads;
+            frame.progress = !c.quiet;
+            frame.target = c.out;
+            frame.depth = true;
+            engine::Stats renderStats;
+            image = engine::renderToImage(scene, ps, frame, camera, c.spp, renderStats);
+        })))
+        return st;
+    fig[kRenderMs] = engine::msSince(r0);
+
+    // RGBA and depth per pixel; the nearest depth wins.
+    const size_t pixels = size_t(c.width) * size_t(c.height);
+    distributed::CompositeFigures cf;
+    std::vector<float> out;
+    const Outcome composited = attempt([&] {
+        std::vector<float> mine(pixels * 5);
+        for (size_t i = 0; i < pixels; ++i) {
+            std::copy_n(image.rgba.data() + i * 4, 4, mine.data() + i * 5);
+            mine[i * 5 + 4] = image.depth[i];
+        }
+        image = {};
+        out = distributed::composite(MPI_COMM_WORLD, mine, c.width, c.height, distributed::CompositeOp::Depth, {}, &cf);
+    });
+    if (composited.status) mpi.abort(composited);  // out of step inside a collective
+    fig[kCompositeMs] = cf.exchangeMs + cf.blendMs + cf.gatherMs;
+    fig[kBytes] = double(cf.bytesSent + cf.bytesReceived);
+    fig[kHwm] = double(procKb("/proc/self/status", "VmHWM"));
+    std::vector<double> all(root ? size_t(mpi.size) * kFigures : 0);
+    MPI_Gather(fig, kFigures, MPI_DOUBLE, all.data(), kFigures, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    if (!root) return 0;
+
+    const Outcome written = attempt([&] {
+        engine::Frame f;
+        f.width = c.width;
+        f.height = c.height;
+        f.rgba.resize(pixels * 4);
+        f.depth.resize(pixels);
+        for (size_t i = 0; i < pixels; ++i) {
+            std::copy_n(out.data() + i * 5, 4, f.rgba.data() + i * 4);
+            f.depth[i] = out[i * 5 + 4];
+        }
+        out = {};
+        engine::applyEyeDomeLighting(f, part.edl);
+        writeImage(c.out, f.width, f.height, f.rgba);
+    });
+    if (written.status) {
+        std::fprintf(stderr, "rtfact: error: rank 0: %s\n", written.message.c_str());
+        return written.status;
+    }
+    if (c.stats) {
+        engine::Stats st;
+        st.add("mpi_ranks", mpi.size);
+        st.add("mpi_distribute", "data");
+        st.add("points", (unsigned long long)part.points);
+        st.add("mpi_cut_axis", std::string(1, "xyz"[part.axis]));
+        st.add("edl", double(part.edl));
+        for (int r = 0; r < mpi.size; ++r) {
+            const double* f = &all[size_t(r) * kFigures];
+            const std::string k = "rank" + std::to_string(r) + "_";
+            st.add(k + "points", (unsigned long long)f[kLoaded]);
+            st.add(k + "ghost_points", (unsigned long long)f[kGhosts]);
+            st.add(k + "load_ms", f[kLoadMs]);
+            st.add(k + "render_ms", f[kRenderMs]);
+            st.add(k + "composite_ms", f[kCompositeMs]);
+            st.add(k + "bytes", (unsigned long long)f[kBytes]);
+            st.add(k + "vmhwm_kb", (unsigned long long)f[kHwm]);
+        }
+        st.print();
+    }
+    return 0;
+}
+
+}  // namespace
 
 }  // namespace rtfact::app

@@ -14,7 +14,9 @@
 #              homogeneous slab crossing them (every channel within 2/255), and each rank
 #              loading about 1/N of the volume plus ghosts (bytes read and VmHWM).
 #   data_failing: a volume file cut short so that only the last rank's slab is missing:
-#              every rank exits 1, one error line naming that rank.
+#              every rank exits 1, one error line naming that rank (points: a rank
+#              without its file).
+#   data points: data-parallel clouds within the regression tolerance of one process.
 set -u
 what="$1" scene="$2" rtfact="$3" mpiexec="$4" data="$5" work="$6" compare="${7:-}"
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
@@ -41,7 +43,68 @@ same() { idiff -fail 0 -failpercent 0 -warn 0 single.exr "$1" >/dev/null; }
 # --stats value of KEY in FILE.
 stat_of() { grep "^$2=" "$1" | head -1 | cut -d= -f2; }
 
-if [ "$what" = data ]; then
+if [ "$what" = data ] && [ "$scene" = points ]; then
+  # Data-parallel clouds: the bunny scan (no normals: normals and radii estimated, so the
+  # ghost points matter; EDL on by default) and with EDL off, against one process.
+  cloud="$data/points/bunny_bun000.ply"
+  pcommon=(--size 200x150 --spp 2 --threads 1 --quiet)
+  n=$(grep -a -m1 "^element vertex" "$cloud" | cut -d' ' -f3)
+  for edl in default 0; do
+    extra=()
+    [ "$edl" = 0 ] && extra=(--edl 0)
+    timeout 300 "$rtfact" points "$cloud" "${extra[@]}" "${pcommon[@]}" -o "single-$edl.exr" ||
+      fail "edl $edl: single-process render"
+    for np in 1 2 3 4; do
+      out="edl-$edl-np$np.exr"
+      timeout 300 "${launch[@]}" -np "$np" "$rtfact" points "$cloud" "${extra[@]}" "${pcommon[@]}" \
+        --distribute data --stats -o "$out" >"$out.stats" 2>"$out.err" || {
+        fail "edl $edl -np $np exited $?: $(cat "$out.err")"
+        continue
+      }
+      cmp=$("$compare" "single-$edl.exr" "$out") || fail "edl $edl -np $np: $cmp"
+      echo "edl $edl -np $np: $cmp"
+      [ "$np" = 1 ] && continue # one process: MPI is not started
+      [ "$(stat_of "$out.stats" mpi_distribute)" = data ] || fail "edl $edl -np $np: not data-parallel"
+      # Every point is owned by exactly one rank, each about 1/N of them (quantile cells).
+      total=0
+      for ((r = 0; r < np; r++)); do
+        own=$(stat_of "$out.stats" "rank${r}_points")
+        [ -n "$own" ] && [ $((own * np * 100)) -ge $((n * 98)) ] && [ $((own * np * 100)) -le $((n * 102)) ] ||
+          fail "edl $edl -np $np: rank $r holds '$own' of $n points, not about 1/$np"
+        total=$((total + ${own:-0}))
+        [ "$(stat_of "$out.stats" "rank${r}_bytes")" -gt 0 ] || fail "edl $edl -np $np: rank $r moved no bytes"
+      done
+      [ "$total" = "$n" ] || fail "edl $edl -np $np: ranks hold $total points, the cloud $n"
+    done
+  done
+  # The parts differ from one process (the check can fail): the cells rendered alone.
+  timeout 300 "$rtfact" points "$cloud" --edl 0 --crop -1,-1,-0.02,1 "${pcommon[@]}" -o half.exr || fail "half render"
+  "$compare" single-0.exr half.exr >/dev/null && fail "half of the cloud passes the comparison"
+  [ "$(stat -c %s single-0.exr)" -gt 1000 ] || fail "single-process image suspiciously small"
+elif [ "$what" = data_failing ] && [ "$scene" = points ]; then
+  # Rank 1 of 3 cannot read its file: every rank exits 1, one line naming rank 1.
+  ranks=()
+  for r in 0 1 2; do
+    [ ${#ranks[@]} -gt 0 ] && ranks+=(:)
+    file="$data/points/bunny_bun000.ply"
+    [ "$r" = 1 ] && file="$work/missing_on_rank_1.ply"
+    ranks+=(-np 1 "$rtfact" points "$file" "${common[@]}" --distribute data -o bad.png)
+  done
+  timeout 120 "${launch[@]}" "${ranks[@]}" >bad.out 2>bad.err
+  rc=$?
+  [ "$rc" = 124 ] && fail "data-parallel cloud: mpirun hung (timeout)"
+  [ "$rc" = 1 ] || fail "data-parallel cloud: mpirun exited $rc, want 1"
+  lines=$(grep -c "^rtfact: error:" bad.err)
+  [ "$lines" = 1 ] || fail "data-parallel cloud: $lines error lines, want 1: $(cat bad.err)"
+  grep -q "^rtfact: error: rank 1: .*missing_on_rank_1.ply" bad.err ||
+    fail "data-parallel cloud: the line does not name rank 1 and its file: $(cat bad.err)"
+  [ -e bad.png ] && fail "data-parallel cloud: an image was written"
+  # A non-eyelight integrator needs the whole cloud: a usage error.
+  timeout 120 "${launch[@]}" -np 2 "$rtfact" points "$data/points/bunny_bun000.ply" "${common[@]}" \
+    --distribute data --integrator ao -o ao.png >/dev/null 2>ao.err
+  rc=$?
+  [ "$rc" = 2 ] || fail "--integrator ao data-parallel: exit $rc, want 2: $(cat ao.err)"
+elif [ "$what" = data ]; then
   "$rtfact" gen volume phantom --size 64 --quiet -o phantom.mhd || fail "gen phantom"
   "$rtfact" gen volume slab --size 64 --thickness 40 --quiet -o slab.mhd || fail "gen slab"
   vcommon=(--size 160x120 --threads 1 --quiet)
@@ -170,11 +233,12 @@ else
       fail "rank $bad failing: the error line does not name rank $bad and its file: $(cat "bad$bad.err")"
     [ -e "bad$bad.png" ] && fail "rank $bad failing: an image was written"
   done
-  timeout 120 "${launch[@]}" -np 2 "$rtfact" "${args[@]}" "${common[@]}" --distribute data -o data.png \
-    >/dev/null 2>data.err
+  timeout 120 "${launch[@]}" -np 2 "$rtfact" mesh "$data/meshes/bunny.ply" "${common[@]}" --distribute data \
+    -o data.png >/dev/null 2>data.err
   rc=$?
-  [ "$rc" = 2 ] || fail "--distribute data: exit $rc, want 2"
-  grep -q "data-parallel rendering is for volumes" data.err || fail "--distribute data: no usage message in: $(cat data.err)"
+  [ "$rc" = 2 ] || fail "--distribute data for a mesh: exit $rc, want 2"
+  grep -q "data-parallel rendering is for volumes and point clouds" data.err ||
+    fail "--distribute data for a mesh: no usage message in: $(cat data.err)"
 fi
 [ "$fails" = 0 ] && echo "mpi $what $scene: ok"
 exit $((fails > 0))
