@@ -18,9 +18,13 @@
 #include "apps/rtfact/commands.h"
 #include "apps/rtfact/common_options.h"
 #include "apps/rtfact/mesh_options.h"
+#include "apps/rtfact/mpi_view.h"
 #include "apps/rtfact/point_options.h"
 #include "apps/rtfact/volume_options.h"
 #include "apps/view/viewer_server.h"
+#ifdef RTFACT_MPI
+#include "apps/rtfact/mpi_render.h"
+#endif
 #include "engine/render_session.h"
 
 extern char** environ;
@@ -70,19 +74,23 @@ void openBrowser(const std::string& url) {
     posix_spawn_file_actions_destroy(&fa);
 }
 
-int serve(CommonOptions& c, const ViewOptions& v, const std::function<engine::Settings()>& settings,
-          const std::function<engine::Scene()>& open, bool defaultPointPacket) {
+// Options, settings, the scene and the viewer's configuration (`writer`: prints the
+// scene's warnings; under MPI only rank 0 does).
+ViewJob prepareView(CommonOptions& c, const ViewOptions& v, const std::function<engine::Settings()>& settings,
+                    const std::function<engine::Scene()>& open, bool defaultPointPacket, bool writer) {
     c.finalize();
     // A bad address is bad usage, found before the data are loaded.
     in6_addr probe{};
     if (inet_pton(AF_INET, v.bind.c_str(), &probe) != 1 && inet_pton(AF_INET6, v.bind.c_str(), &probe) != 1)
         throw CLI::ValidationError("--bind", "expected an IPv4 or IPv6 address, got '" + v.bind + "'");
     engine::Settings s = settings();
-    const engine::Scene scene = open();
-    if (!c.quiet)
+    ViewJob job;
+    job.scene = open();
+    const engine::Scene& scene = job.scene;
+    if (writer && !c.quiet)
         for (const std::string& w : scene.warnings()) std::fprintf(stderr, "rtfact: warning: %s\n", w.c_str());
     const engine::DefaultView view = scene.defaultView(s);
-    viewer::ViewerConfig cfg;
+    viewer::ViewerConfig& cfg = job.config;
     cfg.settings = s;
     cfg.home = c.frame(view.focus, view.viewDir, view.up);
     cfg.frame.width = c.width;
@@ -95,14 +103,35 @@ int serve(CommonOptions& c, const ViewOptions& v, const std::function<engine::Se
     cfg.frameMs = v.frameMs;
     cfg.jpegQuality = v.quality;
     cfg.screenshotSpp = c.spp;
+    job.quiet = c.quiet;
+    return job;
+}
+
+void runServer(ViewJob& job, const ViewOptions& v) {
     viewer::ServerOptions so;
     so.bind = v.bind;
     so.port = v.port;
-    viewer::ViewerServer server(scene, cfg, so);
+    viewer::ViewerServer server(job.scene, job.config, so);
     std::printf("rtfact: viewing at %s\n", server.url().c_str());
     std::fflush(stdout);
     if (!v.noBrowser) openBrowser(server.url());
     server.run();
+}
+
+int serve(CommonOptions& c, const ViewOptions& v, const std::function<engine::Settings()>& settings,
+          const std::function<engine::Scene()>& open, bool defaultPointPacket) {
+#ifdef RTFACT_MPI
+    // Under mpirun: rank 0 serves, every rank renders (apps/rtfact/mpi_view.h).
+    if (mpiLaunched())
+        return runMpiView(
+            [&](bool root) {
+                if (!root) c.quiet = true;
+                return prepareView(c, v, settings, open, defaultPointPacket, root);
+            },
+            [&](ViewJob& job) { runServer(job, v); });
+#endif
+    ViewJob job = prepareView(c, v, settings, open, defaultPointPacket, true);
+    runServer(job, v);
     return 0;
 }
 

@@ -1,5 +1,7 @@
 #include "apps/view/client_session.h"
 
+#include <tuple>
+
 #include "apps/view/image_encoders.h"
 #include "core/util/error.h"
 #include "engine/histogram.h"
@@ -13,6 +15,7 @@ namespace {
 // A camera message newer than this keeps the view "moving" (the page sends moving: false
 // when a drag ends; this covers pages that vanish mid-drag).
 constexpr auto kMoveHold = std::chrono::milliseconds(300);
+std::atomic<uint64_t> nextView{1};
 }  // namespace
 
 ClientSession::ClientSession(engine::Scene scene, ViewerConfig config, Output out)
@@ -25,7 +28,8 @@ ClientSession::ClientSession(engine::Scene scene, ViewerConfig config, Output ou
       width_(config_.frame.width),
       height_(config_.frame.height),
       quality_(config_.jpegQuality),
-      preview_(config_.frameMs) {
+      preview_(config_.frameMs),
+      view_(nextView.fetch_add(1)) {
     config_.frame.progress = false;
     session_ = std::make_shared<engine::RenderSession>(scene_, settings_, config_.frame, camera_);
     thread_ = std::thread([this] { run(); });
@@ -34,6 +38,7 @@ ClientSession::ClientSession(engine::Scene scene, ViewerConfig config, Output ou
 ClientSession::~ClientSession() {
     stop();
     join();
+    if (config_.closeView) config_.closeView(view_);
 }
 
 void ClientSession::stop() {
@@ -123,6 +128,7 @@ void ClientSession::handle(std::string_view text) {
                 out_.text(errorJson(e.message()).dump());
                 return;
             }
+            patch_.merge_patch(msg.settings);
             settingsDirty_ = true;
             restart();
             break;
@@ -223,13 +229,18 @@ void ClientSession::renderOnce(std::unique_lock<std::mutex>& lock) {
     const std::shared_ptr<engine::RenderSession> session = session_;
     const uint64_t generation = generation_;
     const bool mv = moving_;
+    const ViewerConfig::PassRequest request{view_, camera_, settings_, patch_, width_, height_, scale_};
     lock.unlock();
     engine::PassResult r;
     engine::Frame frame;
     std::string error;
     try {
-        r = session->renderPass();
-        if (r.status == engine::PassResult::Status::Done) frame = session->frame();
+        if (config_.renderPass) {
+            std::tie(r, frame) = config_.renderPass(request);
+        } else {
+            r = session->renderPass();
+            if (r.status == engine::PassResult::Status::Done) frame = session->frame();
+        }
     } catch (const Error& e) {
         error = e.message();
     }
@@ -250,6 +261,7 @@ void ClientSession::renderOnce(std::unique_lock<std::mutex>& lock) {
     if (!error.empty()) {
         // Settings the engine refused: back to the last good ones.
         settings_ = goodSettings_;
+        patch_ = goodPatch_;
         settingsDirty_ = true;
         ++generation_;
         accumulated_ = 0;
@@ -258,6 +270,7 @@ void ClientSession::renderOnce(std::unique_lock<std::mutex>& lock) {
     }
     if (r.status != engine::PassResult::Status::Done || generation != generation_) return;  // stale
     goodSettings_ = settings_;
+    goodPatch_ = patch_;
     accumulated_ = r.samples;
     preview_.observe(r.render.ms, double(frame.width) * double(frame.height));
     const uint64_t id = nextFrame_++;

@@ -17,6 +17,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "apps/view/preview_scale.h"
@@ -34,6 +35,20 @@ struct ViewerConfig {
     double frameMs = 40.0;       // preview frame-time target while moving
     int jpegQuality = 85;
     int screenshotSpp = 1;  // samples per pixel of the screenshot PNG (the CLI's --spp)
+    // When set, renders each pass in place of the tab's RenderSession and returns the
+    // accumulated frame: rank 0 of an MPI run shares the pass with every rank
+    // (apps/rtfact/mpi_view.cpp). Called on the tab's render thread; not cancelled.
+    struct PassRequest {
+        uint64_t view = 0;  // the tab (its accumulation)
+        CameraFrame camera;
+        engine::Settings settings;
+        // The page's settings messages merged (JSON merge patch): applied to the
+        // command line's settings, they give `settings` (another process can).
+        nlohmann::json settingsPatch;
+        int width = 0, height = 0, scale = 1;
+    };
+    std::function<std::pair<engine::PassResult, engine::Frame>(const PassRequest&)> renderPass;
+    std::function<void(uint64_t view)> closeView;  // the tab is gone
 };
 
 class ClientSession {
@@ -82,6 +97,7 @@ class ClientSession {
     std::shared_ptr<engine::RenderSession> session_;
     CameraFrame camera_;
     engine::Settings settings_, goodSettings_;
+    nlohmann::json patch_ = nlohmann::json::object(), goodPatch_ = nlohmann::json::object();  // of settings_
     int width_, height_;
     bool stop_ = false, moving_ = false, settingsDirty_ = false, sizeDirty_ = false, screenshotWanted_ = false;
     bool lossless_ = false, idle_ = false;
@@ -93,6 +109,7 @@ class ClientSession {
     std::optional<std::pair<uint64_t, Outgoing>> waiting_;
     PreviewScale preview_;
 
+    const uint64_t view_;  // this tab's id for ViewerConfig::renderPass
     std::atomic<bool> finished_{false};
     std::thread thread_;
 };

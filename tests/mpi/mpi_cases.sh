@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # rtfact under mpirun (tests/mpi/CMakeLists.txt sets the OpenMPI environment).
-# usage: mpi_cases.sh identical|failing|data|data_failing SCENE RTFACT MPIEXEC DATASETS WORK_DIR [COMPARE]
+# usage: mpi_cases.sh identical|failing|data|data_failing|view SCENE RTFACT MPIEXEC DATASETS WORK_DIR [COMPARE]
 #   identical: the image of 2, 3 and 4 ranks (--distribute image) equals the
 #              single-process image bit for bit (float EXR pixels; the files differ in
 #              their DateTime), and -np 1 too.
@@ -17,6 +17,8 @@
 #              every rank exits 1, one error line naming that rank (points: a rank
 #              without its file).
 #   data points: data-parallel clouds within the regression tolerance of one process.
+#   view:      `mpirun -np 2 rtfact view` streams the single-process viewer's frames
+#              (COMPARE: the scripted client, tests/mpi/mpi_view_client.cpp).
 set -u
 what="$1" scene="$2" rtfact="$3" mpiexec="$4" data="$5" work="$6" compare="${7:-}"
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
@@ -43,7 +45,76 @@ same() { idiff -fail 0 -failpercent 0 -warn 0 single.exr "$1" >/dev/null; }
 # --stats value of KEY in FILE.
 stat_of() { grep "^$2=" "$1" | head -1 | cut -d= -f2; }
 
-if [ "$what" = data ] && [ "$scene" = points ]; then
+if [ "$what" = view ]; then
+  # The viewer served by rank 0 of `mpirun -np 2` streams the same frames as a
+  # single-process viewer (lossless PNG, every sample accumulated): the home view, after a
+  # drag, after a settings change; EDL on (the scan has no normals). Stopping rank 0 ends
+  # every rank cleanly (mpirun exits 0).
+  client="$compare"
+  vargs=(view points "$data/points/bunny_bun000.ply" --no-browser --port 0 --size 100x70 --max-samples 3
+    --threads 1 --quiet)
+  # Starts a server (its pid in $server); waits for its URL; runs the client.
+  drive() {
+    local name=$1
+    shift
+    "$@" "${vargs[@]}" >"$name.out" 2>"$name.err" &
+    server=$!
+    local url=""
+    for ((i = 0; i < 600; i++)); do
+      url=$(grep -o 'http://[^ ]*' "$name.out" 2>/dev/null | head -1)
+      [ -n "$url" ] && break
+      kill -0 "$server" 2>/dev/null || break
+      sleep 0.2
+    done
+    [ -n "$url" ] || {
+      fail "$name: no URL from the viewer: $(cat "$name.err")"
+      return 1
+    }
+    local port token
+    port=$(echo "$url" | sed -E 's|http://[^:]+:([0-9]+)/.*|\1|')
+    token=$(echo "$url" | sed -E 's|.*token=([^&]+).*|\1|')
+    timeout 300 "$client" "$port" "$token" "$name" >"$name.client" 2>&1 || fail "$name: client: $(cat "$name.client")"
+  }
+  drive single "$rtfact"
+  kill -TERM "$server"
+  wait "$server" || fail "single-process viewer exited $?"
+  drive mpi "${launch[@]}" -np 2 "$rtfact"
+  # Only rank 0 serves (a rank serving alone would pass the comparison too).
+  [ "$(grep -c 'viewing at' mpi.out)" = 1 ] || fail "not one server under mpirun: $(cat mpi.out)"
+  # Stop rank 0 (the server): it tells rank 1, and both exit.
+  rank0=""
+  for child in $(pgrep -P "$server"); do
+    tr '\0' '\n' <"/proc/$child/environ" 2>/dev/null | grep -qx OMPI_COMM_WORLD_RANK=0 && rank0=$child
+  done
+  if [ -n "$rank0" ]; then
+    kill -TERM "$rank0"
+  else
+    fail "no rank 0 process under mpirun $server"
+    kill -TERM "$server"
+  fi
+  for ((i = 0; i < 600; i++)); do
+    kill -0 "$server" 2>/dev/null || break
+    sleep 0.2
+  done
+  if kill -0 "$server" 2>/dev/null; then
+    fail "mpirun still running 120 s after rank 0 stopped (a rank hung)"
+    kill -KILL "$server"
+  fi
+  wait "$server"
+  rc=$?
+  [ "$rc" = 0 ] || fail "mpirun exited $rc after the viewer stopped: $(cat mpi.err)"
+  grep -q "2 ranks serve the viewer" mpi.err && fail "--quiet: rank 0 still announced the ranks"
+  for v in home moved normal; do
+    [ -s "single-$v.png" ] && [ -s "mpi-$v.png" ] || {
+      fail "$v: frame missing"
+      continue
+    }
+    idiff -fail 0 -failpercent 0 -warn 0 "single-$v.png" "mpi-$v.png" >/dev/null ||
+      fail "$v: the mpirun viewer's frame differs from one process's: $(idiff "single-$v.png" "mpi-$v.png" | grep -i max)"
+  done
+  # The views differ from each other (the comparison can fail).
+  idiff -fail 0 -failpercent 0 -warn 0 single-home.png single-normal.png >/dev/null && fail "home equals normal"
+elif [ "$what" = data ] && [ "$scene" = points ]; then
   # Data-parallel clouds: the bunny scan (no normals: normals and radii estimated, so the
   # ghost points matter; EDL on by default) and with EDL off, against one process.
   cloud="$data/points/bunny_bun000.ply"
