@@ -1,4 +1,5 @@
-// rtfact-bench mesh FILE: RTfact's BVH packet tracer against Embree 3 on the same
+// rtfact-bench mesh FILE: RTfact's mesh tracers (the binary packet BVH, and the wide BVH
+// with its packet traversal, `_wide` figures) against Embree 3 on the same
 // triangles, camera and thread count, in one process. Primary rays (eyelight: nearest
 // hit plus a normal lookup) and one shadow ray per hit towards a point light. Embree
 // runs in its best packet mode for coherent rays: rtcIntersect16/rtcOccluded16 on 4x4
@@ -417,18 +418,21 @@ uint64_t countHits(const Frame& f) {
 
 template <int N>
 int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat,
-        int secSamples, bool wideVariants) {
+        int secSamples, bool wideVariants, float singleNode, float singleLeaf) {
     std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w,
                 h, N, allThreads);
     auto meshPtr = std::make_shared<const Mesh>(mesh);
     const std::vector<int> threadCounts = allThreads > 1 ? std::vector<int>{1, allThreads} : std::vector<int>{1};
-    MeshScene<BVH<Triangle>> scene;
-    scene.mesh = meshPtr;
-    // Build and memory figures are the packet BVH's, which serves the primary and shadow
-    // rays compared with Embree; the wide BVH for single rays is built and timed after.
-    scene.buildWide = false;
-    double rtBuild[2] = {1e30, 1e30}, emBuild[2] = {1e30, 1e30}, wideBuild[2] = {1e30, 1e30};
-    size_t wideBytes = 0;
+    // RTfact's wide BVH alone (packet traversal for primary and shadow rays, single rays
+    // for secondaries), and the binary packet BVH that the renderer's primary and shadow
+    // rays use (its build, memory and packet traversal).
+    MeshScene<BVH<Triangle>> scene, pscene;
+    scene.mesh = pscene.mesh = meshPtr;
+    scene.packetBVH = false;
+    pscene.buildWide = false;
+    if (singleNode >= 0.0f) scene.widePacketTracer.isect.singleRayFraction = singleNode;
+    if (singleLeaf >= 0.0f) scene.widePacketTracer.isect.singleRayLeafFraction = singleLeaf;
+    double rtBuild[2] = {1e30, 1e30}, emBuild[2] = {1e30, 1e30}, packetBuild[2] = {1e30, 1e30};
     std::unique_ptr<EmbreeSide> em;
     for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
         const int T = threadCounts[ti];
@@ -439,58 +443,61 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
             arena.execute([&] { scene.build(); });
             rtBuild[ti] = std::min(rtBuild[ti], msSince(t0));
             arena.execute([&] { emBuild[ti] = std::min(emBuild[ti], em->build(mesh)); });
-            // The wide BVH (direct wide SAH build and triangle blocks) on its own.
-            MeshWideBVH wide;
             const auto t1 = Clock::now();
-            arena.execute([&] { wide = buildMeshWideBVH(mesh, meshTriangleBounds(mesh)); });
-            wideBuild[ti] = std::min(wideBuild[ti], msSince(t1));
-            wideBytes = wide.memoryBytes();
+            arena.execute([&] { pscene.build(); });
+            packetBuild[ti] = std::min(packetBuild[ti], msSince(t1));
         }
-        std::printf("build_ms_threads%d: rtfact=%.2f rtfact_wide=%.2f embree=%.2f ratio_wide=%.3f\n", T, rtBuild[ti],
-                    wideBuild[ti], emBuild[ti], wideBuild[ti] / emBuild[ti]);
+        std::printf("build_ms_threads%d: rtfact=%.2f rtfact_wide=%.2f embree=%.2f ratio=%.3f ratio_wide=%.3f\n", T,
+                    packetBuild[ti], rtBuild[ti], emBuild[ti], packetBuild[ti] / emBuild[ti],
+                    rtBuild[ti] / emBuild[ti]);
     }
-    const double rtBytes = double(scene.memoryBytes()), emBytes = double(gEmbreeBytes.load());
-    {
-        scene.buildWide = true;
-        const auto t0 = Clock::now();
-        scene.build();
-        std::printf("wide_bvh_build_ms_all_threads=%.2f (packet BVH and wide BVH together)\n", msSince(t0));
-    }
-    std::printf("memory_bytes: rtfact=%.0f embree=%.0f ratio_memory=%.3f\n", rtBytes, emBytes,
-                rtBytes / std::max(emBytes, 1.0));
-    std::printf("memory_bytes: rtfact_wide=%.0f embree=%.0f ratio_memory_wide=%.3f\n", double(wideBytes), emBytes,
-                double(wideBytes) / std::max(emBytes, 1.0));
+    const double wideBytes = double(scene.memoryBytes()), rtBytes = double(pscene.memoryBytes()),
+                 emBytes = double(gEmbreeBytes.load());
+    std::printf("memory_bytes: rtfact=%.0f rtfact_wide=%.0f embree=%.0f ratio_memory=%.3f ratio_memory_wide=%.3f\n",
+                rtBytes, wideBytes, emBytes, rtBytes / std::max(emBytes, 1.0), wideBytes / std::max(emBytes, 1.0));
 
-    RTfactSide<N> rt{scene, setup};
-    Frame fr(w, h), fe(w, h), base(w, h);
+    RTfactSide<N> rt{scene, setup}, rtp{pscene, setup};
+    Frame fr(w, h), fe(w, h), fp(w, h), base(w, h);
     // Reference primary hits for the shadow pass, shared by both sides.
     timeTiles(allThreads, w, h, [&](int x, int y) { rt.primaryTile(base, x, y); });
     const uint64_t hits = countHits(base);
     std::printf("primary_hits=%llu\n", (unsigned long long)hits);
-    double worstPrimary = 1e30, worstShadow = 1e30;
+    double worstPrimary = 1e30, worstShadow = 1e30, worstPrimaryWide = 1e30, worstShadowWide = 1e30;
     for (int T : threadCounts) {
-        Result rp, ep, rs, es, esSurf;
+        Result rp, ep, rs, es, esSurf, pp, ps;
         for (int r = 0; r < repeat; ++r) {
             rp.ms = std::min(rp.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fr, x, y); }));
             ep.ms = std::min(ep.ms, timeTiles(T, w, h, [&](int x, int y) { em->primaryTile(fe, x, y); }));
+            pp.ms = std::min(pp.ms, timeTiles(T, w, h, [&](int x, int y) { rtp.primaryTile(fp, x, y); }));
             rs.ms = std::min(rs.ms, timeTiles(T, w, h, [&](int x, int y) { rt.shadowTile(fr, base, x, y); }));
             esSurf.ms =
                 std::min(esSurf.ms, timeTiles(T, w, h, [&](int x, int y) { em->shadowTile(fe, base, x, y, false); }));
             es.ms = std::min(es.ms, timeTiles(T, w, h, [&](int x, int y) { em->shadowTile(fe, base, x, y, true); }));
+            ps.ms = std::min(ps.ms, timeTiles(T, w, h, [&](int x, int y) { rtp.shadowTile(fp, base, x, y); }));
         }
-        rp.rays = ep.rays = uint64_t(w) * h;
-        rs.rays = es.rays = esSurf.rays = hits;
+        rp.rays = ep.rays = pp.rays = uint64_t(w) * h;
+        rs.rays = es.rays = esSurf.rays = ps.rays = hits;
         // Embree's better shadow orientation is the peer.
         const Result& esBest = es.ms <= esSurf.ms ? es : esSurf;
-        std::printf("threads=%d primary_mrays: rtfact=%.2f embree=%.2f ratio=%.3f\n", T, rp.mrays(), ep.mrays(),
-                    rp.mrays() / ep.mrays());
-        std::printf("threads=%d shadow_mrays: rtfact=%.2f embree=%.2f (from light %.2f, to light %.2f) ratio=%.3f\n", T,
-                    rs.mrays(), esBest.mrays(), es.mrays(), esSurf.mrays(), rs.mrays() / esBest.mrays());
-        worstPrimary = std::min(worstPrimary, rp.mrays() / ep.mrays());
-        worstShadow = std::min(worstShadow, rs.mrays() / esBest.mrays());
+        // rtfact: the binary packet BVH (the renderer's); rtfact_wide: the wide BVH's
+        // packet traversal.
+        std::printf(
+            "threads=%d primary_mrays: rtfact=%.2f rtfact_wide=%.2f embree=%.2f ratio=%.3f ratio_wide=%.3f "
+            "wide_vs_packet_bvh=%.3f\n",
+            T, pp.mrays(), rp.mrays(), ep.mrays(), pp.mrays() / ep.mrays(), rp.mrays() / ep.mrays(),
+            rp.mrays() / pp.mrays());
+        std::printf(
+            "threads=%d shadow_mrays: rtfact=%.2f rtfact_wide=%.2f embree=%.2f (from light %.2f, to light %.2f) "
+            "ratio=%.3f ratio_wide=%.3f wide_vs_packet_bvh=%.3f\n",
+            T, ps.mrays(), rs.mrays(), esBest.mrays(), es.mrays(), esSurf.mrays(), ps.mrays() / esBest.mrays(),
+            rs.mrays() / esBest.mrays(), rs.mrays() / ps.mrays());
+        worstPrimary = std::min(worstPrimary, pp.mrays() / ep.mrays());
+        worstShadow = std::min(worstShadow, ps.mrays() / esBest.mrays());
+        worstPrimaryWide = std::min(worstPrimaryWide, rp.mrays() / ep.mrays());
+        worstShadowWide = std::min(worstShadowWide, rs.mrays() / esBest.mrays());
     }
-    // Far views with sub-pixel triangles: the same primary rays one by one through the
-    // wide BVH (not part of the ratios above).
+    // The same primary rays one by one through the wide BVH (not part of the ratios):
+    // what the packet traversal's single-ray hand-over can reach on far views.
     for (int T : threadCounts) {
         Result rw, rp;
         Frame fw(w, h);
@@ -499,8 +506,9 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
             rw.ms = std::min(rw.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fw, x, y, true); }));
         }
         rw.rays = rp.rays = uint64_t(w) * h;
-        std::printf("threads=%d primary_mrays: rtfact_packet=%.2f rtfact_wide_single=%.2f ratio_wide_vs_packet=%.3f\n",
-                    T, rp.mrays(), rw.mrays(), rw.mrays() / rp.mrays());
+        std::printf(
+            "threads=%d primary_mrays: rtfact_wide_packet=%.2f rtfact_wide_single=%.2f ratio_single_vs_packet=%.3f\n",
+            T, rp.mrays(), rw.mrays(), rw.mrays() / rp.mrays());
     }
     // Secondary rays (incoherent): the same list for every tracer.
     if (secSamples > 0) {
@@ -515,7 +523,7 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
                 Result p, wd, e;
                 for (int r = 0; r < repeat; ++r) {
                     p.ms = std::min(p.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
-                                        rtSecondary<N>(scene, sr, b, en, false, ao, outP);
+                                        rtSecondary<N>(pscene, sr, b, en, false, ao, outP);
                                     }));
                     wd.ms = std::min(wd.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
                                          rtSecondary<N>(scene, sr, b, en, true, ao, outW);
@@ -552,19 +560,25 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
             }
         }
     }
-    // Agreement of the two tracers (a sanity check, not a timing).
-    size_t hitDiff = 0, rtOnlyShadow = 0, emOnlyShadow = 0;
+    // Agreement of the tracers (a sanity check, not a timing).
+    size_t hitDiff = 0, rtOnlyShadow = 0, emOnlyShadow = 0, packetDiff = 0;
     for (size_t i = 0; i < fr.t.size(); ++i) {
         hitDiff += (fr.t[i] < kInfinity) != (fe.t[i] < kInfinity);
+        packetDiff += fr.id[i] != fp.id[i] || fr.lit[i] != fp.lit[i];
         if (base.t[i] == kInfinity) continue;
         rtOnlyShadow += !fr.lit[i] && fe.lit[i];
         emOnlyShadow += fr.lit[i] && !fe.lit[i];
     }
-    std::printf("agreement: primary_hit_diff_pixels=%zu shadowed_only_by_rtfact=%zu shadowed_only_by_embree=%zu\n",
-                hitDiff, rtOnlyShadow, emOnlyShadow);
+    std::printf(
+        "agreement: primary_hit_diff_pixels=%zu shadowed_only_by_rtfact=%zu shadowed_only_by_embree=%zu "
+        "wide_vs_binary_packet_diff_pixels=%zu\n",
+        hitDiff, rtOnlyShadow, emOnlyShadow, packetDiff);
     const int last = int(threadCounts.size()) - 1;
-    std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\nratio_build=%.3f\nratio_build_wide=%.3f\n", worstPrimary,
-                worstShadow, rtBuild[last] / emBuild[last], wideBuild[last] / emBuild[last]);
+    std::printf(
+        "ratio_primary=%.3f\nratio_shadow=%.3f\nratio_build=%.3f\nratio_memory=%.3f\nratio_primary_wide=%.3f\n"
+        "ratio_shadow_wide=%.3f\nratio_build_wide=%.3f\nratio_memory_wide=%.3f\n",
+        worstPrimary, worstShadow, packetBuild[last] / emBuild[last], rtBytes / std::max(emBytes, 1.0),
+        worstPrimaryWide, worstShadowWide, rtBuild[last] / emBuild[last], wideBytes / std::max(emBytes, 1.0));
     std::printf(
         "(ratios: RTfact/Embree throughput, the worse of 1 and %d threads; build: RTfact/Embree time at %d threads, "
         "lower is better)\n",
@@ -580,6 +594,7 @@ int benchMesh(int argc, char** argv) {
     float fov = 45.0f;
     int threads = 0, packet = 256, repeat = 3, grid = 1, secondary = 4;
     bool wideVariants = false;
+    float singleNode = -1.0f, singleLeaf = -1.0f;
     app.add_option("FILE", file, "Mesh file")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
     app.add_option("--at", at, "Camera target x,y,z");
@@ -601,6 +616,11 @@ int benchMesh(int argc, char** argv) {
         ->check(CLI::Range(1, 100));
     app.add_flag("--wide-variants", wideVariants,
                  "Also time wide BVH layouts (arity 8/16, leaf blocks of 4/8 triangles) on the secondary rays");
+    app.add_option("--single-lanes", singleNode,
+                   "Wide packet traversal: nodes reached by at most this fraction of a chunk's lanes continue as "
+                   "single rays (tuning; default: the library's)")
+        ->check(CLI::Range(0.0f, 1.0f));
+    app.add_option("--single-lanes-leaf", singleLeaf, "The same for leaves (tuning)")->check(CLI::Range(0.0f, 1.0f));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -653,9 +673,11 @@ int benchMesh(int argc, char** argv) {
         setup.triNormal[i] = normalize(cross(b - a, c - a));
     }
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants);
-    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants);
-    return run<256>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants);
+    if (packet == 16)
+        return run<16>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, singleNode, singleLeaf);
+    if (packet == 64)
+        return run<64>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, singleNode, singleLeaf);
+    return run<256>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, singleNode, singleLeaf);
 }
 
 }  // namespace rtfact::bench

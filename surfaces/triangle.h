@@ -13,6 +13,7 @@
 #include <algorithm>
 
 #include "core/accel/wide_bvh_intersector.h"
+#include "core/accel/wide_bvh_packet_intersector.h"
 #include "core/concepts/intersector.h"
 #include "core/concepts/intersector_hooks.h"
 #include "core/simd/bitmask.h"
@@ -74,6 +75,81 @@ struct TriangleIntersector {
     template <HitData D, int N>
     RTFACT_INLINE void intersect(const Triangle& tri, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit,
                                  int firstChunk) const {
+        intersectChunks<D>(tri, id, rays, hit, firstChunk, Packet<N>::C);
+    }
+
+    // The first n triangles of a block (the rest is padding) against chunk k of a packet
+    // (the wide BVH's packet path): the same per-triangle arithmetic as intersect, so
+    // both structures give the same hits.
+    template <HitData D, int L, int N>
+    RTFACT_INLINE void intersectBlockChunk(const TriangleBlock<L>& b, int n, const RayPacket<N>& rays, Hit<N>& hit,
+                                           int k) const {
+        for (int i = 0; i < n; ++i) {
+            const Triangle t{Vec3f(b.v[0][0][i], b.v[0][1][i], b.v[0][2][i]),
+                             Vec3f(b.v[1][0][i], b.v[1][1][i], b.v[1][2][i]),
+                             Vec3f(b.v[2][0][i], b.v[2][1][i], b.v[2][2][i])};
+            intersectChunks<D>(t, uint32_t(b.id[i]), rays, hit, k, k + 1);
+        }
+    }
+
+    // Lanes `lanes` of chunk k against a block, each lane with one SIMD test over the
+    // block's triangles (the single-ray block arithmetic). With a common origin the edge
+    // functions of the block are computed once for all lanes, and a lane costs four dot
+    // products. Returns the lanes (bits of chunk k) that found a closer hit.
+    template <HitData D, int L, int N>
+    RTFACT_INLINE uint32_t intersectBlockLanes(const TriangleBlock<L>& b, const RayPacket<N>& rays, Hit<N>& hit, int k,
+                                               uint32_t lanes) const {
+        using P = Packet<L>;
+        constexpr int W = Packet<N>::W;
+        uint32_t found = 0;
+        auto lane = [&](int i, const Vec3<L>& a, const Vec3<L>& nn, const Vec3<L>& e0v, const Vec3<L>& e1v,
+                        const Vec3<L>& e2v) __attribute__((always_inline)) {
+            const Vec3<L> d(Vec3f(rays.dir.x[i], rays.dir.y[i], rays.dir.z[i]));
+            const P e0 = dot(e0v, d), e1 = dot(e1v, d), e2 = dot(e2v, d);
+            const P nd = dot(nn, d);
+            const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
+            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != P(0.0f));
+            if (none(inside)) return;
+            const P t = dot(nn, a) / nd;
+            const auto m = inside & (t > P(float(rays.tMin[i]))) & (t < P(float(hit.t[i])));
+            if (none(m)) return;
+            Hit<1> h;
+            takeNearest<D>(m, t, e0, e1, e2, b.id, h);
+            hit.t[i] = h.t;
+            hit.id[i] = h.id;
+            if constexpr (D == HitData::Shading) {
+                hit.u[i] = h.u;
+                hit.v[i] = h.v;
+            }
+            found |= 1u << (i - k * W);
+        };
+        auto rel = [&](const Vec3f& o, Vec3<L>& a, Vec3<L>& bb, Vec3<L>& c) __attribute__((always_inline)) {
+            const P ox(o.x), oy(o.y), oz(o.z);
+            a = Vec3<L>(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
+            bb = Vec3<L>(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
+            c = Vec3<L>(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
+        };
+        if (rays.commonOrigin) {
+            Vec3<L> a, bb, c;
+            rel(Vec3f(rays.org.x[0], rays.org.y[0], rays.org.z[0]), a, bb, c);
+            const Vec3<L> nn = cross(bb - a, c - a);
+            const Vec3<L> e0v = triangleEdge(bb, c), e1v = triangleEdge(c, a), e2v = triangleEdge(a, bb);
+            for (uint32_t r = lanes; r; r &= r - 1) lane(k * W + __builtin_ctz(r), a, nn, e0v, e1v, e2v);
+        } else {
+            for (uint32_t r = lanes; r; r &= r - 1) {
+                const int i = k * W + __builtin_ctz(r);
+                Vec3<L> a, bb, c;
+                rel(Vec3f(rays.org.x[i], rays.org.y[i], rays.org.z[i]), a, bb, c);
+                lane(i, a, cross(bb - a, c - a), triangleEdge(bb, c), triangleEdge(c, a), triangleEdge(a, bb));
+            }
+        }
+        return found;
+    }
+
+    // Chunks [firstChunk, endChunk) of the packet against one triangle.
+    template <HitData D, int N>
+    RTFACT_INLINE void intersectChunks(const Triangle& tri, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit,
+                                       int firstChunk, int endChunk) const {
         constexpr int W = Packet<N>::W;
         using P = Packet<W>;
         using PI = Packet<W, int32_t>;
@@ -106,13 +182,13 @@ struct TriangleIntersector {
             const Vec3f a = tri.v0 - o, b = tri.v1 - o, c = tri.v2 - o;
             const Vec3<W> e0(triangleEdge(b, c)), e1(triangleEdge(c, a)), e2(triangleEdge(a, b)), nn(n);
             const P tnum(dot(n, a));
-            for (int k = firstChunk; k < Packet<N>::C; ++k) {
+            for (int k = firstChunk; k < endChunk; ++k) {
                 const Vec3<W> d = rays.dir.chunk(k);
                 finish(k, dot(e0, d), dot(e1, d), dot(e2, d), tnum, dot(nn, d));
             }
         } else {
             const Vec3<W> v0(tri.v0), v1(tri.v1), v2(tri.v2), nn(n);
-            for (int k = firstChunk; k < Packet<N>::C; ++k) {
+            for (int k = firstChunk; k < endChunk; ++k) {
                 const Vec3<W> o = rays.org.chunk(k), d = rays.dir.chunk(k);
                 const Vec3<W> a = v0 - o, b = v1 - o, c = v2 - o;
                 finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d),
@@ -228,5 +304,8 @@ static_assert(LeafIntersector<TriangleIntersector, Triangle>);
 // ... and SIMD blocks of triangles in a BlockedWideBVH.
 static_assert(BlockIntersector<TriangleIntersector, TriangleBlock<4>> &&
               BlockIntersector<TriangleIntersector, TriangleBlock<8>>);
+// ... and blocks per packet chunk (the wide BVH's packet traversal).
+static_assert(PacketBlockIntersector<TriangleIntersector, TriangleBlock<4>> &&
+              PacketBlockIntersector<TriangleIntersector, TriangleBlock<8>>);
 
 }  // namespace rtfact::surfaces

@@ -72,7 +72,13 @@ struct WideBVHIntersector {
         return occ;
     }
 
-   private:
+    // Continues a query at `root` (an inner node) with hit.t the distance to beat: packet
+    // traversals hand lanes over to single rays here.
+    template <HitData D, bool AnyHit, class Tree>
+    void traverseFrom(const Tree& bvh, const RayPacket<1>& ray, Hit<1>& hit, int32_t root) const {
+        traverse<D, AnyHit>(bvh, ray, hit, root);
+    }
+
     // Copies every field of a single-ray hit into lane i of a packet hit. Hit records
     // are structs of 4-byte packets (t, id, u, v, ...), so Hit<N> is Hit<1> with every
     // field widened to N lanes.
@@ -86,6 +92,7 @@ struct WideBVHIntersector {
         for (int f = 0; f < kFields; ++f) std::memcpy(d + (size_t(f) * N + size_t(i)) * 4, s + size_t(f) * 4, 4);
     }
 
+   private:
     // One leaf (first, count) against the ray; returns true when an any-hit query is done.
     template <HitData D, bool AnyHit, class Elem, int K>
     RTFACT_INLINE bool leaf(const WideBVH<Elem, K>& bvh, int32_t first, int32_t count, const RayPacket<1>& ray,
@@ -126,7 +133,7 @@ struct WideBVHIntersector {
     // once a closer hit is known. Any hit: no ordering at all, larger children first
     // (the builder's slot order). Every inner child entered or pushed is prefetched.
     template <HitData D, bool AnyHit, class Tree>
-    void traverse(const Tree& bvh, const RayPacket<1>& ray, Hit<1>& hit) const {
+    void traverse(const Tree& bvh, const RayPacket<1>& ray, Hit<1>& hit, int32_t root = 0) const {
         if (bvh.nodes.empty()) return;
         constexpr int K = Tree::arity;
         using P = Packet<K>;
@@ -151,7 +158,7 @@ struct WideBVHIntersector {
         // than the binary ones they may come from, whose traversal assumes depth < 128.
         Entry stack[(K - 1) * 128 + 1];
         int sp = 0;
-        int32_t node = 0;
+        int32_t node = root;
         for (;;) {
             const WideBVHNode<K>& n = nodes[node];
             const float* f = n.lo[0];

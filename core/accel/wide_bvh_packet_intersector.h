@@ -1,0 +1,356 @@
+// Packet traversal of a BlockedWideBVH<Block, K> (coherent rays: primary rays, shadow
+// rays from a light). A packet of N rays is traversed one native chunk of W lanes at a
+// time; per node the K children are first culled against the whole chunk at once by
+// interval arithmetic on the chunk's origins and reciprocal directions (its "frustum":
+// one SIMD test over the K children), then the surviving children are tested lane by
+// lane (one W-wide slab test each). Stack entries keep the lanes that hit them, and an
+// entry reached by few lanes continues as single rays (WideBVHIntersector) from that
+// node: the far view of sub-pixel triangles, where a chunk's rays no longer share
+// nodes, costs what single rays cost. Leaves are tested per chunk against each element
+// of a block (common-origin edge functions shared by the chunk) when most lanes reach
+// them, else lane by lane against whole blocks (one SIMD test per block).
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+
+#include "core/accel/wide_bvh.h"
+#include "core/accel/wide_bvh_intersector.h"
+#include "core/concepts/intersector.h"
+#include "core/util/assert.h"
+
+namespace rtfact {
+
+// Block leaves against one native chunk k of a packet: the first n elements of the block
+// (the rest are padding) update the lanes of chunk k with tMin < t < hit.t.
+template <class I, class Block>
+concept PacketBlockIntersector = BlockIntersector<I, Block> &&
+    requires(const I& isect, const Block& b, int n, const RayPacket<simd::kNativeWidth>& rays,
+             typename I::template Hit<simd::kNativeWidth>& hit) {
+    isect.template intersectBlockChunk<HitData::Distance>(b, n, rays, hit, 0);
+    isect.template intersectBlockChunk<HitData::Shading>(b, n, rays, hit, 0);
+    // Lanes (bits of chunk 0) one by one against the whole block; returns the lanes hit.
+    { isect.template intersectBlockLanes<HitData::Shading>(b, rays, hit, 0, 1u) } -> std::same_as<uint32_t>;
+    { isect.template intersectBlockLanes<HitData::Distance>(b, rays, hit, 0, 1u) } -> std::same_as<uint32_t>;
+};
+
+template <class ElemIsect>
+struct WideBVHPacketIntersector {
+    ElemIsect elem{};
+    // Entries reached by at most this fraction of a chunk's lanes (at least one lane)
+    // continue as single rays; 0: never, 1: always (tests use both ends).
+    float singleRayFraction = 0.25f;
+    // The same for leaves: a block costs one ray about what one element costs a chunk, so
+    // single rays win there up to most of the chunk's lanes.
+    float singleRayLeafFraction = 0.75f;
+    template <int N>
+    using Hit = typename ElemIsect::template Hit<N>;
+
+    template <bool CommonOrigin, HitData D, class Tree, int N>
+    void intersect(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
+        if constexpr (N == 1) {
+            single().template intersect<CommonOrigin, D>(bvh, rays, hit, active);
+        } else {
+            traversePacket<CommonOrigin, D, false>(bvh, rays, hit, active);
+            hit.t = select(active, hit.t, rays.tMax);
+        }
+    }
+
+    template <bool CommonOrigin, class Tree, int N>
+    Mask<N> occluded(const Tree& bvh, const RayPacket<N>& rays, const Mask<N>& active) const {
+        if constexpr (N == 1) {
+            return single().template occluded<CommonOrigin>(bvh, rays, active);
+        } else {
+            Hit<N> hit;
+            traversePacket<CommonOrigin, HitData::Distance, true>(bvh, rays, hit, active);
+            return active & (hit.id != Packet<N, int32_t>(-1));
+        }
+    }
+
+    // Lane order in which each native chunk of an N-ray packet is a compact tile of the
+    // image. Packets from the renderer are bw x bh pixels in row-major order (bw the
+    // smallest divisor of N with bw * bw >= N, core/render's packetBlockWidth), so W
+    // consecutive lanes would be a thin strip (16 x 1 pixels for 256 rays on AVX-512);
+    // cw x ch tiles cross fewer small nodes. Only speed depends on it: any packet is
+    // traced correctly in any order. perm[i] is the packet lane that regrouped lane i holds.
+    template <int N>
+    struct ChunkTiles {
+        static constexpr int W = Packet<N>::W;
+        static constexpr int bw = [] {
+            for (int d = 1; d <= N; ++d)
+                if (N % d == 0 && d * d >= N) return d;
+            return N;
+        }();
+        static constexpr int bh = N / bw;
+        static constexpr int cw = W >= 8 ? 4 : 2, ch = W / cw;
+        static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % ch == 0;
+        static constexpr std::array<int16_t, N> perm = [] {
+            std::array<int16_t, N> p{};
+            const int tilesX = bw / cw;
+            for (int i = 0; i < N; ++i) {
+                const int tile = i / W, l = i % W;
+                const int x = (tile % tilesX) * cw + l % cw, y = (tile / tilesX) * ch + l / cw;
+                p[size_t(i)] = int16_t(y * bw + x);
+            }
+            return p;
+        }();
+    };
+
+   private:
+    // The active lanes chunk by chunk, in the tiled lane order when the packet has one.
+    template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
+    void traversePacket(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
+        hit.t = select(active, rays.tMax, Packet<N>(-kInfinity));
+        hit.id = Packet<N, int32_t>(-1);
+        using T = ChunkTiles<N>;
+        if constexpr (T::kEnabled) {
+            RayPacket<N> r;
+            Hit<N> h;
+            r.commonOrigin = rays.commonOrigin;
+            for (int i = 0; i < N; ++i) {
+                const int j = T::perm[size_t(i)];
+                for (int a = 0; a < 3; ++a) {
+                    r.org[a][i] = rays.org[a][j];
+                    r.dir[a][i] = rays.dir[a][j];
+                    r.invDir[a][i] = rays.invDir[a][j];
+                }
+                r.tMin[i] = rays.tMin[j];
+                r.tMax[i] = rays.tMax[j];
+                h.t[i] = hit.t[j];
+            }
+            h.id = Packet<N, int32_t>(-1);
+            traverseChunks<CommonOrigin, D, AnyHit>(bvh, r, h);
+            // Hit records are 4-byte lane packets (as WideBVHIntersector::setHitLane).
+            static_assert(sizeof(Hit<N>) % (4 * N) == 0, "hit records must consist of 4-byte lane packets");
+            constexpr int kFields = int(sizeof(Hit<N>) / (4 * N));
+            auto* d = reinterpret_cast<unsigned char*>(&hit);
+            const auto* src = reinterpret_cast<const unsigned char*>(&h);
+            for (int f = 0; f < kFields; ++f)
+                for (int i = 0; i < N; ++i)
+                    std::memcpy(d + (size_t(f) * N + size_t(T::perm[size_t(i)])) * 4,
+                                src + (size_t(f) * N + size_t(i)) * 4, 4);
+        } else {
+            traverseChunks<CommonOrigin, D, AnyHit>(bvh, rays, hit);
+        }
+    }
+    // Lanes with hit.t > -inf are active.
+    template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
+    void traverseChunks(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit) const {
+        const BitMask<N> bits(hit.t > Packet<N>(-kInfinity));
+        for (int k = 0; k < Packet<N>::C; ++k)
+            if (const uint32_t lanes = bits.chunkBits(k))
+                traverseChunk<CommonOrigin, D, AnyHit>(bvh, rays, hit, k, lanes);
+    }
+
+    WideBVHIntersector<ElemIsect> single() const { return WideBVHIntersector<ElemIsect>{elem}; }
+
+    // Lane i of chunk k as a single ray from `node` (an inner node, or a leaf given by
+    // its first block and element count); the result goes back into the packet's hit.
+    template <HitData D, bool AnyHit, class Tree, int N>
+    RTFACT_INLINE void singleLane(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, int lane, int32_t child,
+                                  int32_t count) const {
+        const RayPacket<1> r = rays.lane(lane);
+        Hit<1> h;
+        h.t = hit.t[lane];
+        h.id = -1;
+        if (count == 0) {
+            single().template traverseFrom<D, AnyHit>(bvh, r, h, child);
+        } else {
+            const auto* b = bvh.blocks.data() + child;
+            const int nb = Tree::blockCount(count);
+            if constexpr (AnyHit)
+                elem.occludedBlocks(b, nb, r, h);
+            else
+                elem.template intersectBlocks<D>(b, nb, r, h);
+        }
+        if (int32_t(h.id) < 0) return;
+        WideBVHIntersector<ElemIsect>::setHitLane(hit, lane, h);
+        if constexpr (AnyHit) hit.t[lane] = -kInfinity;  // done: no box test passes any more
+    }
+
+    // Chunk k (active lanes `lanes`) through the tree.
+    template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
+    void traverseChunk(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, int k, uint32_t lanes) const {
+        if (bvh.nodes.empty()) return;
+        constexpr int K = Tree::arity;
+        constexpr int W = Packet<N>::W;
+        static_assert(W <= 32, "lane masks are 32 bits");
+        using P = Packet<W>;
+        using PK = Packet<K>;
+        using Block = typename Tree::BlockType;
+        static_assert(PacketBlockIntersector<ElemIsect, Block>, "the element intersector must test blocks per chunk");
+        const int singleLanes = std::max(1, int(singleRayFraction * float(W)));
+        const int singleLeafLanes =
+            singleRayLeafFraction > 0.0f ? std::max(1, int(singleRayLeafFraction * float(W))) : 0;
+        if (singleRayFraction > 0.0f && __builtin_popcount(lanes) <= singleLanes) {
+            for (uint32_t b = lanes; b; b &= b - 1)
+                singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), 0, 0);
+            return;
+        }
+        uint32_t open = lanes;  // lanes still searching (any hit: without an occluder)
+        const Mask<W> chunkActive = hit.t.chunk(k) > P(-kInfinity);
+
+        // The chunk's interval of origins and reciprocal directions (active lanes).
+        const P inf(kInfinity);
+        float orgLo[3], orgHi[3], invLo[3], invHi[3];
+        bool uniform = true;
+        int nearOff[3], farOff[3];
+        P org[3], inv[3];
+        for (int a = 0; a < 3; ++a) {
+            inv[a] = rays.invDir[a].chunk(k);
+            org[a] = CommonOrigin ? P(rays.org[a][0]) : rays.org[a].chunk(k);
+            invLo[a] = hmin(select(chunkActive, inv[a], inf));
+            invHi[a] = hmax(select(chunkActive, inv[a], -inf));
+            orgLo[a] = CommonOrigin ? rays.org[a][0] : hmin(select(chunkActive, org[a], inf));
+            orgHi[a] = CommonOrigin ? rays.org[a][0] : hmax(select(chunkActive, org[a], -inf));
+            uniform = uniform && (invLo[a] > 0.0f || invHi[a] < 0.0f);
+            // Near and far plane offsets into the node's bounds (lo[3][K] then hi[3][K]).
+            nearOff[a] = (invHi[a] < 0.0f ? 3 * K : 0) + a * K;
+            farOff[a] = (invHi[a] < 0.0f ? 0 : 3 * K) + a * K;
+        }
+        const P& tMin = rays.tMin.chunk(k);
+        const float tMinLo = hmin(select(chunkActive, tMin, inf));
+        float tMaxHi = hmax(hit.t.chunk(k));
+
+        // Slab test of the chunk's lanes against child c of the node with bounds f, up to
+        // each lane's current hit; tn receives the entry distances.
+        auto laneHits = [&](const float* f, int c, P& tn) __attribute__((always_inline)) {
+            P tf = hit.t.chunk(k);
+            tn = tMin;
+            for (int a = 0; a < 3; ++a) {
+                float lo = f[a * K + c], hi = f[3 * K + a * K + c];
+                if (uniform && invHi[a] < 0.0f) std::swap(lo, hi);
+                P t0, t1;
+                if constexpr (CommonOrigin) {
+                    t0 = P(lo - orgLo[a]) * inv[a];
+                    t1 = P(hi - orgLo[a]) * inv[a];
+                } else {
+                    t0 = (P(lo) - org[a]) * inv[a];
+                    t1 = (P(hi) - org[a]) * inv[a];
+                }
+                if (uniform) {
+                    tn = max(tn, t0);
+                    tf = min(tf, t1);
+                } else {
+                    tn = max(tn, min(t0, t1));
+                    tf = min(tf, max(t0, t1));
+                }
+            }
+            return tn <= tf;
+        };
+        // An entry remembers its parent and slot, so its lanes are tested again against the
+        // hits found since it was pushed.
+        struct Entry {
+            int32_t child, count;
+            float dist;
+            uint32_t lanes;
+            int32_t parent, slot;
+        };
+        Entry stack[(K - 1) * 128 + 1];
+        int sp = 0;
+        int32_t node = 0;
+        uint32_t nodeLanes = lanes;
+        for (;;) {
+            const WideBVHNode<K>& n = bvh.nodes[size_t(node)];
+            const float* f = n.lo[0];
+            // Children some lane of the chunk may hit (empty slots never pass).
+            uint64_t cand;
+            if (uniform) {
+                PK entry(tMinLo), exit(tMaxHi);
+                for (int a = 0; a < 3; ++a) {
+                    const PK iL(invLo[a]), iH(invHi[a]);
+                    const PK nearP = PK::load(f + nearOff[a]), farP = PK::load(f + farOff[a]);
+                    if constexpr (CommonOrigin) {
+                        const PK dn = nearP - PK(orgLo[a]), df = farP - PK(orgLo[a]);
+                        entry = max(entry, min(dn * iL, dn * iH));
+                        exit = min(exit, max(df * iL, df * iH));
+                    } else {
+                        const PK dn0 = nearP - PK(orgLo[a]), dn1 = nearP - PK(orgHi[a]);
+                        const PK df0 = farP - PK(orgLo[a]), df1 = farP - PK(orgHi[a]);
+                        entry = max(entry, min(min(dn0 * iL, dn0 * iH), min(dn1 * iL, dn1 * iH)));
+                        exit = min(exit, max(max(df0 * iL, df0 * iH), max(df1 * iL, df1 * iH)));
+                    }
+                }
+                cand = BitMask<K>(entry <= exit).w[0];
+            } else {
+                cand = BitMask<K>(PK::load(f) <= PK::load(f + 3 * K)).w[0];
+            }
+            // Each candidate against the chunk's lanes.
+            const int base = sp;
+            RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the traversal stack");
+            for (; cand; cand &= cand - 1) {
+                const int c = __builtin_ctzll(cand);
+                P tn;
+                const Mask<W> m = laneHits(f, c, tn);
+                const uint32_t hitLanes = uint32_t(BitMask<W>(m).w[0]) & nodeLanes;
+                if (!hitLanes) continue;
+                Entry e{n.child[c], n.count[c], 0.0f, hitLanes, node, c};
+                if constexpr (AnyHit) {
+                    stack[sp++] = e;
+                } else {
+                    e.dist = hmin(select(m, tn, inf));
+                    // Far to near: the nearest ends on top.
+                    int j = sp++;
+                    while (j > base && stack[j - 1].dist < e.dist) {
+                        stack[j] = stack[j - 1];
+                        --j;
+                    }
+                    stack[j] = e;
+                }
+            }
+            // Pop the nearest entry that can still hold a closer hit; run leaves and
+            // hand entries with few lanes to single rays.
+            for (;;) {
+                if (sp == 0) return;
+                Entry e = stack[--sp];
+                if constexpr (AnyHit) {
+                    e.lanes &= open;
+                    if (!e.lanes) continue;
+                } else {
+                    if (!(e.dist <= tMaxHi)) continue;
+                    // Lanes that found a hit in front of the entry leave it.
+                    P tn;
+                    e.lanes &= uint32_t(BitMask<W>(laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn)).w[0]);
+                    if (!e.lanes) continue;
+                }
+                const int lanesHit = __builtin_popcount(e.lanes);
+                const bool few =
+                    e.count == 0 ? singleRayFraction > 0.0f && lanesHit <= singleLanes : lanesHit <= singleLeafLanes;
+                if (e.count == 0 && !few) {
+                    node = e.child;
+                    nodeLanes = e.lanes;
+                    break;
+                }
+                if (few && e.count == 0) {
+                    for (uint32_t b = e.lanes; b; b &= b - 1)
+                        singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), e.child, e.count);
+                } else if (few) {
+                    const Block* blocks = bvh.blocks.data() + e.child;
+                    const int nb = Tree::blockCount(e.count);
+                    uint32_t l = e.lanes;
+                    for (int j = 0; j < nb && l; ++j) {
+                        const uint32_t f = elem.template intersectBlockLanes<D>(blocks[j], rays, hit, k, l);
+                        if constexpr (AnyHit) l &= ~f;
+                    }
+                } else {
+                    const Block* blocks = bvh.blocks.data() + e.child;
+                    const int nb = Tree::blockCount(e.count);
+                    for (int j = 0; j < nb; ++j)
+                        elem.template intersectBlockChunk<D>(
+                            blocks[j], std::min(Tree::kBlock, e.count - j * Tree::kBlock), rays, hit, k);
+                }
+                if constexpr (AnyHit) {
+                    // Lanes that found an occluder leave the traversal.
+                    const Mask<W> found = hit.id.chunk(k) != Packet<W, int32_t>(-1);
+                    hit.t.chunk(k) = select(found, P(-kInfinity), hit.t.chunk(k));
+                    open &= ~uint32_t(BitMask<W>(found).w[0]);
+                    if (!open) return;
+                }
+                tMaxHi = hmax(hit.t.chunk(k));
+            }
+        }
+    }
+};
+
+}  // namespace rtfact
