@@ -1,9 +1,9 @@
-// rtfact-bench points FILE: RTfact's LoD kd-tree disc tracer (full detail and LoD)
-// against Embree 3 oriented-disc points (RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT) with the
-// same centres, normals (decoded from RTfact's quantised ones) and radii, the same camera
-// rays and thread counts, in one process. Embree runs in its best mode for coherent
-// primary rays: rtcIntersect16 on 4x4 pixel blocks, coherent context flag, medium build.
-// Both sides do the same per-pixel work: ray generation, nearest hit, eyelight shading
+// rtfact-bench points FILE: RTfact's LoD disc tracer (full detail and LoD; the wide
+// BVH of disc blocks, or with --accel kd the LoD kd-tree) against Embree 3 oriented-disc points
+// (RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT) with the same centres, normals (decoded from RTfact's quantised ones) and
+// radii, the same camera rays and thread counts, in one process. Embree runs in its best mode for coherent primary
+// rays: rtcIntersect16 on 4x4 pixel blocks, coherent context flag, medium build. Both sides do the same per-pixel work:
+// ray generation, nearest hit, eyelight shading
 // (|cos| x point colour) written to a frame. PSNR of LoD against full detail is on that
 // shading, 8-bit.
 #include <embree3/rtcore.h>
@@ -173,11 +173,17 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
     const float quality = qualities.front();
     // The engine's scene renders; the rebuilds below only time the builder on its discs.
     PointScene& scene = *built;
-    std::vector<Disc> discs = scene.tree.elems;
+    std::vector<Disc> discs = scene.discs();
     const size_t n = discs.size();
     std::printf(
-        "file=%s\npoints=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nrep_scale=%.3g\nload_ms=%.1f\n",
-        file.c_str(), n, w, h, N, all, quality, repScales.front(), loadMs);
+        "file=%s\npoints=%zu\naccel=%s%s\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nrep_scale=%."
+        "3g\nload_"
+        "ms=%.1f\n",
+        file.c_str(), n, scene.isWide() ? "wide" : "kd",
+        !scene.isWide()                        ? ""
+        : scene.wideSplit == LoDWideSplit::Sah ? " (sah)"
+                                               : " (median)",
+        w, h, N, all, quality, repScales.front(), loadMs);
     const std::vector<int> threadCounts = all > 1 ? std::vector<int>{1, all} : std::vector<int>{1};
     LoDKdTreeBuilder builder;
     builder.maxLeafSize = leafSize;
@@ -190,6 +196,8 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
             resizeFreshHugePages(copy, discs.size());
             std::copy(discs.begin(), discs.end(), copy.begin());
             PointScene rebuilt;
+            rebuilt.accel = scene.accel;
+            rebuilt.wideSplit = scene.wideSplit;
             const auto t0 = Clock::now();
             arena.execute([&] { rebuilt.build(std::move(copy), builder); });
             rtBuild = std::min(rtBuild, msSince(t0));
@@ -203,7 +211,7 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
         for (int r = 0; r < std::max(1, std::min(repeat, 2)); ++r)
             arena.execute([&] { emBuild = std::min(emBuild, em.build()); });
     }
-    const double rtBytes = double(scene.tree.memoryBytes());
+    const double rtBytes = double(scene.memoryBytes());
     // Embree keeps its own copy of the points (16 B centre+radius, 12 B normal) plus the BVH.
     const double emBytes = double(gEmbreeBytes.load()) + double(n) * 28.0;
     std::printf("build_ms: rtfact=%.1f embree=%.1f ratio_build_time=%.3f rtfact_points_per_s=%.3g\n", rtBuild, emBuild,
@@ -261,7 +269,7 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
 
 int benchPoints(int argc, char** argv) {
     CLI::App app{"RTfact LoD kd-tree discs vs Embree oriented-disc points", "rtfact-bench points"};
-    std::string file, eye, at, up, size = "1024x1024", normals = "auto";
+    std::string file, eye, at, up, size = "1024x1024", normals = "auto", accel = "wide", split = "sah";
     float fov = 45.0f, radius = 0.0f, radiusFactor = 1.0f;
     std::vector<float> quality{1.0f}, repScale{0.7f};
     int threads = 0, packet = 16, repeat = 3, leafSize = 8;
@@ -285,7 +293,15 @@ int benchPoints(int argc, char** argv) {
                    "Hit radius of representatives / covering radius (more values: extra LoD runs)")
         ->capture_default_str()
         ->check(CLI::Range(0.1f, 1.0f));
-    app.add_option("--leaf-size", leafSize, "Maximum points per leaf")->capture_default_str()->check(CLI::Range(1, 64));
+    app.add_option("--accel", accel, "RTfact structure: wide (the default) or kd (the LoD kd-tree)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"wide", "kd"}));
+    app.add_option("--wide-split", split, "Wide BVH build: sah (the default) or median (faster build)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"sah", "median"}));
+    app.add_option("--leaf-size", leafSize, "Maximum points per kd-tree leaf")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
     app.add_option("--radius", radius, "Disc radius for every point");
     app.add_option("--radius-factor", radiusFactor, "Scale of the radii")->capture_default_str();
     app.add_option("--normals", normals, "auto|estimate|file")->capture_default_str();
@@ -320,6 +336,16 @@ int benchPoints(int argc, char** argv) {
     frame.fovDeg = fov;
     const PinholeCamera cam(frame, w, h);
     std::shared_ptr<PointScene> scene = engine::builtPoints(sc, settings, frame);
+    if (accel == "kd" || split == "median") {  // the engine builds the default structure; others from its discs
+        auto other = std::make_shared<PointScene>();
+        other->accel = accel == "kd" ? PointAccel::KdTree : PointAccel::Wide;
+        other->wideSplit = split == "median" ? LoDWideSplit::Median : LoDWideSplit::Sah;
+        other->colorMode = scene->colorMode;
+        LoDKdTreeBuilder b;
+        b.maxLeafSize = leafSize;
+        other->build(scene->discs(), b);
+        scene = other;
+    }
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
     switch (packet) {
         case 1:

@@ -99,9 +99,9 @@ std::shared_ptr<PointScene> buildPointScene(SceneData& d, const PointSettings& s
         }
         const double buildMs = msSince(t0);
         stats.add("build_ms", buildMs);
-        stats.add("build_points_per_s", buildMs > 0 ? double(scene->tree.elems.size()) / (buildMs * 1e-3) : 0.0);
-        stats.add("bytes_per_point", scene->tree.bytesPerPoint());
-        stats.add("tree_nodes", (unsigned long long)scene->tree.nodes.size());
+        stats.add("build_points_per_s", buildMs > 0 ? double(scene->discs().size()) / (buildMs * 1e-3) : 0.0);
+        stats.add("bytes_per_point", scene->bytesPerPoint());
+        stats.add("tree_nodes", (unsigned long long)scene->nodeCount());
         pd.scene = scene;
         pd.buildKey = buildKey;
     }

@@ -1,12 +1,15 @@
 // PointScene: a point cloud as a GeometryScene (core/concepts/scene.h), so that the
 // core's generic integrators (eyelight, direct light with shadows, AO, Whitted and
-// path tracing) render it. Hits come from the LoD kd-tree; shading data from the disc or
-// representative disc hit, coloured by the chosen colour mode.
+// path tracing) render it. Hits come from one of two LoD structures: the wide BVH of SoA
+// disc blocks with child representatives in the parents (default) or the LoD kd-tree;
+// shading data from the disc or representative disc hit, coloured by the chosen colour
+// mode.
 #pragma once
 #include "core/concepts/scene.h"
 #include "core/render/tracer.h"
 #include "points/disc_intersector.h"
 #include "points/lod_kdtree_intersector.h"
+#include "points/lod_wide_intersector.h"
 #include "points/point_prepare.h"
 
 namespace rtfact::points {
@@ -19,15 +22,30 @@ inline Vec3f lodLevelColor(int level) {
     return pal[std::min(level, 7)];
 }
 
+// Which structure a PointScene builds. Wide: one SIMD test per node for K children
+// and per block of 8 discs, child representatives beside the node (rtfact-bench points
+// --accel compares both). KdTree: binary, 16-ray packets, representatives in the node.
+enum class PointAccel { Wide, KdTree };
+
 struct PointScene {
-    LoDKdTree tree;
+    PointAccel accel = PointAccel::Wide;         // set before build()
+    LoDWideSplit wideSplit = LoDWideSplit::Sah;  // set before build()
+    LoDKdTree tree;                              // PointAccel::KdTree
+    LoDWideBVH wide;                             // PointAccel::Wide
     Tracer<LoDKdTreeIntersector<DiscIntersector>> tracer;
+    Tracer<LoDWideIntersector> wideTracer;
     ColorMode colorMode = ColorMode::Rgb;
     template <int N>
     using Hit = DiscIntersector::Hit<N>;
 
+    // The LoD kd-tree builder's leaf size applies to the kd-tree only.
     void build(std::vector<Disc> discs, const LoDKdTreeBuilder& builder = {}) {
-        tree = builder.build(std::move(discs));
+        tree = {};
+        wide = {};
+        if (accel == PointAccel::Wide)
+            wide = buildLoDWideBVH(std::move(discs), wideSplit);
+        else
+            tree = builder.build(std::move(discs));
         tracer.isect.elem.bind(tree);
     }
     // Footprint of the camera rays and the LoD quality (0: full detail).
@@ -36,16 +54,30 @@ struct PointScene {
         tracer.isect.elem.repScale = repScale;
         tracer.isect.elem.cone = cone;
         tracer.isect.elem.quality = quality;
+        wideTracer.isect.repScale = repScale;
+        wideTracer.isect.cone = cone;
+        wideTracer.isect.quality = quality;
     }
-    AABB bounds() const { return tree.box; }
-    const Disc& disc(int32_t id) const { return id >= 0 ? tree.elems[size_t(id)] : tree.inner[size_t(-id - 2)].rep; }
+    bool isWide() const { return accel == PointAccel::Wide; }
+    // The input discs (kd-tree: in leaf order); ids >= 0 index them.
+    const std::vector<Disc>& discs() const { return isWide() ? wide.elems : tree.elems; }
+    size_t memoryBytes() const { return isWide() ? wide.memoryBytes() : tree.memoryBytes(); }
+    double bytesPerPoint() const { return discs().empty() ? 0.0 : double(memoryBytes()) / double(discs().size()); }
+    size_t nodeCount() const { return isWide() ? wide.nodes.size() : tree.nodes.size(); }
+    AABB bounds() const { return isWide() ? wide.box : tree.box; }
+    const Disc& disc(int32_t id) const {
+        if (isWide()) return wide.disc(id);
+        return id >= 0 ? tree.elems[size_t(id)] : tree.inner[size_t(-id - 2)].rep;
+    }
 
     template <int N>
     Hit<N> intersect(const RayPacket<N>& rays, const Mask<N>& active) const {
+        if (isWide()) return wideTracer.intersect(wide, rays, active);
         return tracer.intersect(tree, rays, active);
     }
     template <int N>
     Mask<N> occluded(const RayPacket<N>& rays, const Mask<N>& active) const {
+        if (isWide()) return wideTracer.occluded(wide, rays, active);
         return tracer.occluded(tree, rays, active);
     }
     template <int N>
@@ -92,5 +124,6 @@ struct PointScene {
 };
 static_assert(GeometryScene<PointScene>);
 static_assert(Intersector<LoDKdTreeIntersector<DiscIntersector>, KdTree<Disc>>);
+static_assert(Intersector<LoDWideIntersector, LoDWideBVH>);
 
 }  // namespace rtfact::points

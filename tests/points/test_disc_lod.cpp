@@ -1,8 +1,10 @@
-// Disc intersector against an analytic reference; LoD traversal at quality 0 against
-// brute force over all discs (single rays and packets); representative discs cover
+// Disc intersector against an analytic reference; LoD traversal at quality 0 and the
+// full-detail wide BVH of disc blocks against brute force over all discs (single rays
+// and packets), the wide BVH's blocks and boxes; representative discs cover
 // their subtrees and are hit where full detail is; normal estimation on a plane and a sphere.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -121,7 +123,7 @@ template <int N>
 void checkAgainstBruteForce(const PointScene& scene, bool commonOrigin, uint32_t seed) {
     std::mt19937 g(seed);
     std::uniform_real_distribution<float> u(-1, 1);
-    const auto& discs = scene.tree.elems;
+    const auto& discs = scene.discs();
     int hits = 0;
     for (int round = 0; round < 40; ++round) {
         RayPacket<N> rays;
@@ -167,6 +169,7 @@ TEST_P(LoDTraversal, QualityZeroEqualsBruteForce) {
     PointScene scene;
     LoDKdTreeBuilder b;
     b.maxLeafSize = GetParam();
+    scene.accel = PointAccel::KdTree;
     scene.build(randomDiscs(3000, 11), b);
     scene.setLoD(RayCone{0.0f, 0.01f}, 0.0f);
     checkAgainstBruteForce<1>(scene, false, 21);
@@ -178,9 +181,108 @@ TEST_P(LoDTraversal, QualityZeroEqualsBruteForce) {
 }
 INSTANTIATE_TEST_SUITE_P(LeafSizes, LoDTraversal, ::testing::Values(1, 4, 8, 16));
 
+// Full detail through the wide BVH of disc blocks (the default structure): the same
+// hits as brute force at every packet width.
+TEST(DiscWideBVH, FullDetailEqualsBruteForce) {
+    for (int n : {1, 7, 8, 9, 17, 3000})  // one partial block, one full, a block and one, three, many
+        for (LoDWideSplit split : {LoDWideSplit::Sah, LoDWideSplit::Median}) {
+            SCOPED_TRACE(n);
+            SCOPED_TRACE(split == LoDWideSplit::Sah ? "sah" : "median");
+            PointScene scene;
+            scene.wideSplit = split;
+            std::vector<Disc> discs = randomDiscs(n, 12 + uint32_t(n));
+            if (n < 100)
+                for (Disc& d : discs) d.radius = 0.6f;  // few discs: large, so that random rays hit some
+            scene.build(discs);
+            scene.setLoD(RayCone{0.0f, 0.01f}, 0.0f);
+            ASSERT_TRUE(scene.isWide());
+            ASSERT_FALSE(scene.wide.nodes.empty());
+            checkAgainstBruteForce<1>(scene, false, 31);
+            checkAgainstBruteForce<1>(scene, true, 32);
+            checkAgainstBruteForce<simd::kNativeWidth>(scene, true, 33);
+            checkAgainstBruteForce<simd::kNativeWidth>(scene, false, 34);
+            checkAgainstBruteForce<64>(scene, true, 35);
+            checkAgainstBruteForce<64>(scene, false, 36);
+            checkAgainstBruteForce<256>(scene, true, 37);
+            checkAgainstBruteForce<256>(scene, false, 38);
+        }
+}
+
+// Builder invariants: every disc sits in exactly one block lane (padding lanes repeat the
+// block's last disc), with its decoded normal and squared radius, inside the box its
+// parent stores for the leaf; inner children's boxes contain their nodes' boxes.
+class DiscWideBVHSplit : public ::testing::TestWithParam<LoDWideSplit> {};
+
+TEST_P(DiscWideBVHSplit, BlocksHoldEveryDiscOnceInsideTheirBoxes) {
+    const std::vector<Disc> input = randomDiscs(5000, 41);
+    const LoDWideBVH w = buildLoDWideBVH(input, GetParam());
+    const std::vector<Disc>& discs = w.elems;  // reordered: the same multiset
+    auto key = [](const Disc& d) { return std::make_tuple(d.center.x, d.center.y, d.center.z, d.radius, d.normal); };
+    std::vector<std::tuple<float, float, float, float, uint32_t>> a, b;
+    for (const Disc& d : input) a.push_back(key(d));
+    for (const Disc& d : discs) b.push_back(key(d));
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    if (GetParam() == LoDWideSplit::Median) {  // every leaf one block, all full but the last
+        EXPECT_EQ(w.blocks.size(), (discs.size() + DiscWideBVH::kBlock - 1) / DiscWideBVH::kBlock);
+    }
+    constexpr int K = DiscWideBVH::arity, S = DiscWideBVH::kBlock;
+    std::vector<int> seen(discs.size(), 0);
+    std::vector<std::pair<int32_t, AABB>> work{{0, w.box}};
+    size_t leaves = 0;
+    while (!work.empty()) {
+        const auto [ni, box] = work.back();
+        work.pop_back();
+        const auto& node = w.nodes[size_t(ni)];
+        for (int c = 0; c < K; ++c) {
+            if (node.isEmpty(c)) continue;
+            const AABB cb = node.box(c);
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_GE(cb.lo[a], box.lo[a]);
+                EXPECT_LE(cb.hi[a], box.hi[a]);
+            }
+            if (!node.isLeaf(c)) {
+                work.push_back({node.child[c], cb});
+                continue;
+            }
+            ++leaves;
+            const int cnt = node.count[c];
+            for (int e = 0; e < cnt; ++e) {
+                const auto& b = w.blocks[size_t(node.child[c] + e / S)];
+                const int lane = e % S;
+                const int32_t id = b.id[lane];
+                ASSERT_GE(id, 0);
+                ASSERT_LT(size_t(id), discs.size());
+                ++seen[size_t(id)];
+                const Disc& d = discs[size_t(id)];
+                const Vec3f nn = d.n();
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_EQ(b.c[a][lane], d.center[a]);
+                    EXPECT_EQ(b.n[a][lane], nn[a]);
+                }
+                EXPECT_EQ(b.r2[lane], d.radius * d.radius);
+                const AABB db = d.bounds();
+                const float eps = 1e-6f * (1.0f + maxComponent(vmax(-db.lo, db.hi)));  // last-bit rounding
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_GE(db.lo[a], cb.lo[a] - eps);
+                    EXPECT_LE(db.hi[a], cb.hi[a] + eps);
+                }
+            }
+            if (cnt % S) {  // padding lanes repeat the last disc
+                const auto& b = w.blocks[size_t(node.child[c] + (cnt - 1) / S)];
+                for (int lane = cnt % S; lane < S; ++lane) EXPECT_EQ(b.id[lane], b.id[cnt % S - 1]);
+            }
+        }
+    }
+    EXPECT_GT(leaves, discs.size() / (4 * size_t(S)));
+    for (size_t i = 0; i < seen.size(); ++i) ASSERT_EQ(seen[i], 1) << "disc " << i;
+}
+
 TEST(LoDTree, RepresentativeDiscsCoverTheirSubtrees) {
     const std::vector<Disc> input = randomDiscs(5000, 31);
     PointScene scene;
+    scene.accel = PointAccel::KdTree;
     scene.build(input);
     const LoDKdTree& t = scene.tree;
     ASSERT_EQ(t.elems.size(), input.size());
@@ -287,6 +389,7 @@ struct RepHitStats {
 // representative discs are hit.
 RepHitStats checkRepresentativeHits(const std::vector<Disc>& discs) {
     PointScene scene;
+    scene.accel = PointAccel::KdTree;
     scene.build(discs);
     const LoDKdTree& t = scene.tree;
     // Element range of the subtree under each inner node, by inner index.
@@ -366,6 +469,174 @@ TEST(LoDTree, CoarseQualityAnswersWithRepresentatives) {
     // Measured 237 of 246: the others see through a gap between representatives.
     EXPECT_GE(surf.withinBound, surf.fullHits * 9 / 10) << surf.withinBound << " of " << surf.fullHits;
 }
+
+namespace {
+
+// Slots (node * K + child) on the path from the root to each disc of a LoD wide BVH.
+std::vector<std::vector<uint32_t>> wideSlotsOfDiscs(const LoDWideBVH& w) {
+    constexpr int K = LoDWideBVH::K, S = DiscWideBVH::kBlock;
+    std::vector<std::vector<uint32_t>> slots(w.elems.size());
+    std::function<void(int32_t, std::vector<uint32_t>&)> walk = [&](int32_t ni, std::vector<uint32_t>& path) {
+        const auto& node = w.nodes[size_t(ni)];
+        for (int c = 0; c < K; ++c) {
+            if (node.isEmpty(c)) continue;
+            path.push_back(uint32_t(ni) * K + uint32_t(c));
+            if (node.isLeaf(c)) {
+                for (int e = 0; e < node.count[c]; ++e)
+                    slots[size_t(w.blocks[size_t(node.child[c] + e / S)].id[e % S])] = path;
+            } else {
+                walk(node.child[c], path);
+            }
+            path.pop_back();
+        }
+    };
+    std::vector<uint32_t> path;
+    walk(0, path);
+    return slots;
+}
+
+// At a coarse quality, lane by lane through packets of N: nearest and any hit agree
+// (the cut does not depend on the hit so far), representatives are hit on their scaled
+// discs, and within (1 + repScale) R of full detail where that hits their subtree.
+template <int N>
+RepHitStats checkWideRepresentativeHits(const PointScene& scene, bool commonOrigin, uint32_t seed) {
+    const LoDWideBVH& w = scene.wide;
+    const auto slots = wideSlotsOfDiscs(w);
+    const float repScale = 0.7f;
+    const PinholeCamera cam(fitCamera(scene.bounds(), 45.0f, 1.0f), 32, 32);
+    std::mt19937 g(seed);
+    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+    RepHitStats st;
+    PointScene& sc = const_cast<PointScene&>(scene);
+    for (int first = 0; first < 1024; first += N) {
+        Packet<N> px, py;
+        for (int i = 0; i < N; ++i) px[i] = float((first + i) % 32) + 0.5f, py[i] = float((first + i) / 32 % 32) + 0.5f;
+        RayPacket<N> rays;
+        cam.generate<N>(px, py, rays);
+        if (!commonOrigin) {  // origins moved along the rays: distinct, same footprints roughly
+            for (int i = 0; i < N; ++i)
+                rays.setLane(i, rays.org.lane(i) + rays.dir.lane(i) * (0.3f + u(g)), rays.dir.lane(i), 0.0f, kInfinity);
+            rays.commonOrigin = false;
+            rays.finalize();
+        }
+        Mask<N> active(true);
+        for (int i = 5; i < N; i += 9) active.set(i, false);
+        sc.setLoD(cam.cone(), 8.0f, repScale);
+        const auto coarse = scene.intersect<N>(rays, active);
+        const Mask<N> occ = scene.occluded<N>(rays, active);
+        sc.setLoD(cam.cone(), 0.0f, repScale);
+        const auto full = scene.intersect<N>(rays, active);
+        for (int i = 0; i < N; ++i) {
+            if (!active[i]) continue;
+            EXPECT_EQ(bool(occ[i]), coarse.id[i] != -1) << "lane " << i;
+            if (coarse.id[i] > -2) continue;
+            ++st.repHits;
+            const uint32_t slot = uint32_t(-coarse.id[i] - 2);
+            const Disc& rep = w.reps[slot];
+            const float R = rep.radius;
+            const Vec3f p = rays.org.lane(i) + rays.dir.lane(i) * coarse.t[i];
+            EXPECT_NEAR(dot(p - rep.center, rep.n()), 0.0f, 1e-4f * std::max(1.0f, R)) << "off the disc plane";
+            EXPECT_LE(length(p - rep.center), repScale * R * (1.0f + 1e-4f)) << "outside the scaled disc";
+            const int32_t f = full.id[i];
+            if (f < 0) continue;
+            ++st.fullHits;
+            const float bound = (1.0f + repScale) * R * (1.0f + 1e-4f);
+            st.withinBound += std::fabs(coarse.t[i] - full.t[i]) <= bound;
+            const auto& path = slots[size_t(f)];
+            if (std::find(path.begin(), path.end(), slot) != path.end()) {
+                ++st.sameSubtree;
+                EXPECT_LE(std::fabs(coarse.t[i] - full.t[i]), bound);
+            }
+        }
+    }
+    return st;
+}
+
+}  // namespace
+
+// Builder invariants of the LoD summaries: each child's representative covers every disc
+// of the child's subtree, the SoA copy in the parent matches it, its level is the
+// subtree's height, and empty slots are never cut.
+TEST_P(DiscWideBVHSplit, ChildRepresentativesCoverTheirSubtrees) {
+    const PointScene scene = [] {
+        PointScene s;
+        s.wideSplit = GetParam();
+        s.build(randomDiscs(5000, 51));
+        return s;
+    }();
+    const LoDWideBVH& w = scene.wide;
+    constexpr int K = LoDWideBVH::K;
+    ASSERT_EQ(w.childReps.size(), w.nodes.size());
+    ASSERT_EQ(w.reps.size(), w.nodes.size() * K);
+    const auto slots = wideSlotsOfDiscs(w);
+    std::vector<int> covered(w.reps.size(), 0);
+    for (size_t i = 0; i < w.elems.size(); ++i) {
+        ASSERT_FALSE(slots[i].empty()) << "disc " << i << " in no leaf";
+        const Disc& d = w.elems[i];
+        for (uint32_t slot : slots[i]) {
+            // The farthest point of the disc from the representative's centre.
+            const Disc& rep = w.reps[slot];
+            const Vec3f off = d.center - rep.center, nn = d.n();
+            const float along = dot(off, nn), across = length(off - nn * along);
+            EXPECT_LE(std::sqrt(along * along + (across + d.radius) * (across + d.radius)), rep.radius * (1.0f + 1e-5f))
+                << "slot " << slot;
+            ++covered[slot];
+        }
+        EXPECT_EQ(w.reps[slots[i].back()].level(), 1);  // a leaf child
+    }
+    for (size_t ni = 0; ni < w.nodes.size(); ++ni)
+        for (int c = 0; c < K; ++c) {
+            const size_t slot = ni * K + size_t(c);
+            const auto& cr = w.childReps[ni];
+            if (w.nodes[ni].isEmpty(c)) {
+                EXPECT_EQ(cr.radius[c], kInfinity);
+                EXPECT_EQ(covered[slot], 0);
+                continue;
+            }
+            EXPECT_GT(covered[slot], 0);
+            const Disc& rep = w.reps[slot];
+            EXPECT_EQ(cr.radius[c], rep.radius);
+            const Vec3f nn = rep.n();
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_EQ(cr.c[a][c], rep.center[a]);
+                EXPECT_EQ(cr.n[a][c], nn[a]);
+            }
+            if (!w.nodes[ni].isLeaf(c)) {
+                EXPECT_GE(rep.level(), 2);
+            }
+        }
+}
+
+TEST_P(DiscWideBVHSplit, CoarseQualityAnswersWithRepresentatives) {
+    PointScene vol;
+    vol.wideSplit = GetParam();
+    vol.build(randomDiscs(4000, 41));
+    std::vector<Disc> sphere = randomDiscs(4000, 42);
+    std::mt19937 g(43);
+    for (Disc& d : sphere) {
+        d.center = randomUnit(g);
+        d.normal = encodeNormal(d.center);
+        d.radius = 0.06f;
+    }
+    PointScene surf;
+    surf.wideSplit = GetParam();
+    surf.build(sphere);
+    for (bool common : {true, false}) {
+        SCOPED_TRACE(common);
+        const RepHitStats a = checkWideRepresentativeHits<1>(vol, common, 61);
+        EXPECT_GT(a.repHits, 0);
+        EXPECT_GT(a.sameSubtree, 0);
+        checkWideRepresentativeHits<simd::kNativeWidth>(vol, common, 62);
+        checkWideRepresentativeHits<64>(vol, common, 63);
+        checkWideRepresentativeHits<256>(vol, common, 64);
+        const RepHitStats b = checkWideRepresentativeHits<64>(surf, common, 65);
+        EXPECT_GT(b.repHits, 100);
+        EXPECT_GE(b.fullHits, b.repHits * 9 / 10) << "representatives where full detail sees nothing";
+        EXPECT_GE(b.withinBound, b.fullHits * 9 / 10) << b.withinBound << " of " << b.fullHits;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Splits, DiscWideBVHSplit, ::testing::Values(LoDWideSplit::Sah, LoDWideSplit::Median));
 
 TEST(NormalEstimation, PlaneWithinOneDegree) {
     std::mt19937 g(5);

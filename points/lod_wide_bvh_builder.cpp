@@ -1,0 +1,275 @@
+// buildLoDWideBVH: see lod_wide_bvh.h.
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <limits>
+
+#include "core/accel/wide_bvh_builder.h"
+#include "core/util/assert.h"
+#include "core/util/error.h"
+#include "points/lod_rep.h"
+#include "points/lod_wide_bvh.h"
+#include "points/median_select.h"
+
+namespace rtfact::points {
+
+namespace {
+
+constexpr int K = LoDWideBVH::K;
+static_assert(WideSAHBVHBuilder::kMaxDepth <= LoDWideBVH::kMaxDepth, "the traversal stack assumes this depth");
+
+struct Sum {
+    LoDRepSum s;
+    Disc rep;  // covering radius set
+};
+
+constexpr int S = DiscWideBVH::kBlock;
+
+// The leaf of up to S discs at d[0..n): block b, its sum and representative.
+Sum leafBlock(LoDWideBVH& t, uint32_t first, uint32_t n) {
+    Sum k;
+    const Disc* d = t.elems.data() + first;
+    for (uint32_t i = 0; i < n; ++i) k.s.add(d[i]);
+    k.s.height = 1;
+    k.rep = k.s.rep();
+    float r = 0;
+    for (uint32_t i = 0; i < n; ++i) r = std::max(r, length(d[i].center - k.rep.center) + d[i].radius);
+    k.rep.radius = coverMargin(std::min(r, boxCoverRadius(k.rep.center, k.s.box)));
+
+    std::array<uint32_t, S> ids;
+    for (int i = 0; i < S; ++i) ids[size_t(i)] = first + uint32_t(i);
+    t.blocks[first / S].fill(ids.data(), int(n), [&](uint32_t i) -> const Disc& { return t.elems[i]; });
+    return k;
+}
+
+// How a range of `count` discs is cut into the (at most K) children of a wide node: the
+// largest part of more than S discs is halved, at a multiple of S, until there are K.
+// It depends on the count only, so node slots are known before the discs are sorted,
+// every part starts at a multiple of S (leaves are exactly one block) and siblings stay
+// in memory order.
+struct Plan {
+    int parts = 1;
+    uint32_t first[K] = {0}, count[K] = {0};
+    int split[K - 1];  // part halved by each step, in order
+    uint32_t half[K - 1];
+};
+Plan makePlan(uint32_t count) {
+    Plan p;
+    p.count[0] = count;
+    for (int step = 0; p.parts < K; ++step) {
+        int best = -1;
+        for (int i = 0; i < p.parts; ++i)
+            if (p.count[i] > uint32_t(S) && (best < 0 || p.count[i] > p.count[best])) best = i;
+        if (best < 0) break;
+        const uint32_t h = (p.count[best] + S - 1) / S / 2 * S;
+        for (int i = p.parts; i > best + 1; --i) p.first[i] = p.first[i - 1], p.count[i] = p.count[i - 1];
+        p.first[best + 1] = p.first[best] + h;
+        p.count[best + 1] = p.count[best] - h;
+        p.count[best] = h;
+        p.split[step] = best;
+        p.half[step] = h;
+        ++p.parts;
+    }
+    return p;
+}
+
+// Wide nodes in the subtree of a range of `count` discs (memoised: few distinct counts).
+struct NodeCounts {
+    std::vector<std::pair<uint32_t, uint32_t>> memo;
+    uint32_t operator()(uint32_t count) {
+        for (const auto& [c, v] : memo)
+            if (c == count) return v;
+        const Plan p = makePlan(count);
+        uint32_t v = 1;
+        for (int i = 0; i < p.parts; ++i)
+            if (p.count[i] > uint32_t(S)) v += (*this)(p.count[i]);
+        memo.emplace_back(count, v);
+        return v;
+    }
+};
+
+struct Ctx {
+    LoDWideBVH* t;
+    NodeCounts* counts;  // read only during the build (every count was seen up front)
+};
+
+// Node `ni` over elems[first, first + count) (cell: bounds of the centres): median splits
+// of the longest cell axis as planned, children built (the large ones in parallel), their
+// boxes and representatives stored in the node; returns the node's sum. Subtrees take
+// the slots after their parent, depth first.
+Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, const AABB& rootCell, int depth) {
+    LoDWideBVH& t = *ctx.t;
+    RTFACT_ASSERT(depth < LoDWideBVH::kMaxDepth, "wide LoD tree deeper than its traversal stack");
+    const Plan p = makePlan(count);
+    // Replay the plan on the discs: each step selects the median of one part.
+    AABB cell[K];
+    uint32_t pf[K] = {0}, pc[K] = {count};
+    cell[0] = rootCell;
+    Disc* d = t.elems.data() + first;
+    for (int step = 0, parts = 1; parts < p.parts; ++step, ++parts) {
+        const int b = p.split[step];
+        const uint32_t h = p.half[step];
+        const int axis = cell[b].maxAxis();
+        selectMedianByCoordinate(d + pf[b], pc[b], h, axis);
+        const float split = d[pf[b] + h].center[axis];
+        for (int i = parts; i > b + 1; --i) cell[i] = cell[i - 1], pf[i] = pf[i - 1], pc[i] = pc[i - 1];
+        cell[b + 1] = cell[b];
+        cell[b].hi[axis] = split;
+        cell[b + 1].lo[axis] = split;
+        pf[b + 1] = pf[b] + h;
+        pc[b + 1] = pc[b] - h;
+        pc[b] = h;
+    }
+    // Slots: children's subtrees follow this node in part order.
+    uint32_t slot[K];
+    uint32_t next = ni + 1;
+    for (int i = 0; i < p.parts; ++i) {
+        slot[i] = next;
+        if (p.count[i] > uint32_t(S)) next += (*ctx.counts)(p.count[i]);
+    }
+    Sum kids[K];
+    auto child = [&](int i) {
+        if (p.count[i] <= uint32_t(S))
+            kids[i] = leafBlock(t, first + p.first[i], p.count[i]);
+        else
+            kids[i] = buildNode(ctx, slot[i], first + p.first[i], p.count[i], cell[i], depth + 1);
+    };
+    if (count >= 32768)
+        tbb::parallel_for(0, p.parts, child);
+    else
+        for (int i = 0; i < p.parts; ++i) child(i);
+    WideBVHNode<K>& node = t.nodes[ni];
+    LoDChildReps<K>& cr = t.childReps[ni];
+    Sum out;
+    for (int c = 0; c < K; ++c) {
+        Disc& rep = t.reps[size_t(ni) * K + size_t(c)];
+        if (c >= p.parts) {
+            node.clear(c);
+            cr.radius[c] = std::numeric_limits<float>::infinity();
+            for (int a = 0; a < 3; ++a) cr.c[a][c] = cr.n[a][c] = 0.0f;
+            rep = Disc{};
+            continue;
+        }
+        const bool leaf = p.count[c] <= uint32_t(S);
+        node.set(c, kids[c].s.box, int32_t(leaf ? (first + p.first[c]) / S : slot[c]), leaf ? int32_t(p.count[c]) : 0);
+        rep = kids[c].rep;
+        const Vec3f nn = rep.n();
+        cr.radius[c] = rep.radius;
+        for (int a = 0; a < 3; ++a) {
+            cr.c[a][c] = rep.center[a];
+            cr.n[a][c] = nn[a];
+        }
+        out.s.add(kids[c].s);
+    }
+    out.s.height += 1;
+    out.rep = out.s.rep();
+    float r = 0;
+    for (int c = 0; c < p.parts; ++c) r = std::max(r, length(kids[c].rep.center - out.rep.center) + kids[c].rep.radius);
+    out.rep.radius = coverMargin(std::min(r, boxCoverRadius(out.rep.center, out.s.box)));
+    return out;
+}
+
+// SAH split: the representatives of node `ni`'s children from the built topology, stored
+// in its slots; returns the node's sum. The top levels run in parallel (disjoint slots).
+Sum summarise(LoDWideBVH& t, int32_t ni, int depth) {
+    const WideBVHNode<K>& node = t.nodes[size_t(ni)];
+    Sum kids[K];
+    auto child = [&](int c) {
+        if (node.isEmpty(c)) return;
+        Sum& k = kids[c];
+        if (node.isLeaf(c)) {
+            const int cnt = node.count[c];
+            const auto* blocks = t.blocks.data() + node.child[c];
+            for (int e = 0; e < cnt; ++e) k.s.add(t.elems[size_t(blocks[e / S].id[e % S])]);
+            k.s.height = 1;
+            k.rep = k.s.rep();
+            float r = 0;
+            for (int e = 0; e < cnt; ++e) {
+                const Disc& d = t.elems[size_t(blocks[e / S].id[e % S])];
+                r = std::max(r, length(d.center - k.rep.center) + d.radius);
+            }
+            k.rep.radius = coverMargin(std::min(r, boxCoverRadius(k.rep.center, k.s.box)));
+        } else {
+            k = summarise(t, node.child[c], depth + 1);
+        }
+    };
+    if (depth < 3)
+        tbb::parallel_for(0, K, child);
+    else
+        for (int c = 0; c < K; ++c) child(c);
+    Sum out;
+    LoDChildReps<K>& cr = t.childReps[size_t(ni)];
+    for (int c = 0; c < K; ++c) {
+        Disc* rep = &t.reps[size_t(ni) * K + size_t(c)];
+        if (node.isEmpty(c)) {
+            cr.radius[c] = std::numeric_limits<float>::infinity();
+            for (int a = 0; a < 3; ++a) cr.c[a][c] = cr.n[a][c] = 0.0f;
+            *rep = Disc{};
+            continue;
+        }
+        *rep = kids[c].rep;
+        const Vec3f nn = rep->n();
+        cr.radius[c] = rep->radius;
+        for (int a = 0; a < 3; ++a) {
+            cr.c[a][c] = rep->center[a];
+            cr.n[a][c] = nn[a];
+        }
+        out.s.add(kids[c].s);
+    }
+    out.s.height += 1;
+    out.rep = out.s.rep();
+    float r = 0;
+    for (int c = 0; c < K; ++c)
+        if (!node.isEmpty(c)) r = std::max(r, length(kids[c].rep.center - out.rep.center) + kids[c].rep.radius);
+    out.rep.radius = coverMargin(std::min(r, boxCoverRadius(out.rep.center, out.s.box)));
+    return out;
+}
+
+// The core's wide SAH builder (Embree-medium-like binned SAH, parallel) on the discs'
+// tight bounds, leaves costed in blocks of 8; discs stay in input order.
+LoDWideBVH buildSah(std::vector<Disc> discs) {
+    LoDWideBVH t;
+    std::vector<AABB> bounds(discs.size());
+    tbb::parallel_for(size_t(0), discs.size(), [&](size_t i) { bounds[i] = discs[i].bounds(); });
+    WideSAHBVHBuilder b;
+    b.leafBlock = kDiscLeafBlock;
+    b.maxLeafSize = 2 * kDiscLeafBlock;
+    WideBVHTopology<K> topo;
+    b.build(std::span<const AABB>(bounds), topo);
+    using Block = DiscBlock<kDiscLeafBlock>;
+    static_cast<DiscWideBVH&>(t) =
+        packLeafBlocks<Block>(std::move(topo), [&](Block& blk, const uint32_t* ids, int cnt) {
+            blk.fill(ids, cnt, [&](uint32_t i) -> const Disc& { return discs[i]; });
+        });
+    t.elems = std::move(discs);
+    t.order = {};  // blocks carry the ids
+    resizeHugePages(t.childReps, t.nodes.size());
+    resizeHugePages(t.reps, t.nodes.size() * size_t(K));
+    summarise(t, 0, 0);
+    return t;
+}
+
+}  // namespace
+
+LoDWideBVH buildLoDWideBVH(std::vector<Disc> discs, LoDWideSplit split) {
+    if (discs.empty()) throw Error("", "cannot build a point tree over no points");
+    if (discs.size() >= (size_t(1) << 29)) throw Error("", "too many points for one tree (limit 2^29)");
+    if (split == LoDWideSplit::Sah) return buildSah(std::move(discs));
+    LoDWideBVH t;
+    const uint32_t n = uint32_t(discs.size());
+    t.elems = std::move(discs);
+    NodeCounts counts;
+    const uint32_t nodes = counts(n);
+    resizeFreshHugePages(t.nodes, nodes);
+    resizeFreshHugePages(t.childReps, nodes);
+    resizeFreshHugePages(t.reps, size_t(nodes) * K);
+    resizeHugePages(t.blocks, (n + S - 1) / S);
+    AABB cell;
+    for (const Disc& d : t.elems) cell.extend(d.center);
+    Ctx ctx{&t, &counts};
+    const Sum root = buildNode(ctx, 0, 0, n, cell, 0);
+    t.box = root.s.box;
+    return t;
+}
+
+}  // namespace rtfact::points
