@@ -27,15 +27,21 @@
 #include "bench/bench_commands.h"
 #include "bench/bench_common.h"
 #include "bench/bench_vtk_volume.h"
+#include "core/render/framebuffer.h"
 #include "core/render/image_io.h"
 #include "core/render/pinhole_camera.h"
+#include "core/render/pixel_center_sampler.h"
+#include "core/render/ray_tracing_renderer.h"
 #include "core/render/srgb.h"
+#include "core/render/tile_scheduler.h"
 #include "core/simd/native.h"
 #include "core/util/error.h"
 #include "engine/built_scene.h"
 #include "engine/render_session.h"
 #include "volume/transfer_function.h"
+#include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
+#include "volume/volume_scene.h"
 
 namespace rtfact::bench {
 namespace {
@@ -148,7 +154,7 @@ int benchVolume(int argc, char** argv) {
         "(VolumeRayIntersector + BoxSampler)"};
     std::string file, dims, type, tfName = "ct-bone", size = "1024x1024", eye, at, up, outPrefix, mode = "dvr";
     float step = 0.5f, fov = 45.0f, refStep = 0.1f;
-    int threads = 0, frames = 3, packet = 16;
+    int threads = 0, frames = 3, packet = 64;
     std::optional<float> window, level;
     bool skipPeer = false, skipVtk = false;
     app.add_option("FILE", file, "Volume file")->required();
@@ -378,18 +384,24 @@ int benchVolume(int argc, char** argv) {
         vtkImage = vtk->image();
     }
     if (refStep > 0) {
-        // The fine-step reference: RTfact, same TF (its opacity corrected for the finer step).
+        // The fine-step reference: RTfact's plain march (no opacity-adaptive steps), same TF
+        // (its opacity corrected for the finer step), same camera, rendered through the
+        // volume library directly so that the adaptive steps can be switched off.
         engine::Settings refSettings = settings;
         refSettings.volume.step = refStep;
-        engine::FrameOptions fo;
-        fo.width = w;
-        fo.height = h;
-        fo.packet = packet;
-        fo.threads = allThreads;
+        const engine::BuiltVolume refBuilt = engine::builtVolume(sc, refSettings);
+        VolumeRenderSettings plain = refBuilt.setup.render;
+        plain.maxStepMultiple = 1;
         t0 = Clock::now();
-        engine::RenderSession session(sc, refSettings, fo, frame);
-        session.renderPass();
-        refImage = session.frame().rgba;
+        withVolumeScene(vol, refBuilt.setup.table, plain, [&](const auto& scene) {
+            RGBAFramebuffer fb(w, h);
+            const RayTracingRenderer<PixelCenterSampler, VolumeIntegrator> renderer{};
+            RenderOptions ro;
+            ro.threads = allThreads;
+            ro.progress = false;
+            renderImage<64>(renderer, scene, cam, fb, ro);
+            refImage = fb.resolved(1);
+        });
         std::printf(
             "quality: PSNR of RGB over black (linear, peak 1; 8-bit sRGB in brackets) against RTfact at step %g "
             "voxels (%.0f ms)%s:\n",

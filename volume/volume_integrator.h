@@ -21,25 +21,42 @@ struct VolumeIntegrator {
         Radiance<N> r;
         uint64_t samples = 0;
         float skipped = 0;
-        for (int k = 0; k < Packet<N>::C; ++k) {
-            constexpr int W = Packet<N>::W;
-            Vec3<W> col;
-            Packet<W> alpha, depth;
-            march<W>(s, rays.org.chunk(k), rays.dir.chunk(k), rays.tMin.chunk(k), rays.tMax.chunk(k), active.chunk(k),
-                     col, alpha, depth, samples, skipped);
-            r.color.setChunk(k, col);
-            r.alpha.chunk(k) = alpha;
-            r.depth.chunk(k) = depth;
+        // Two native chunks march together when the packet has them: their gather chains
+        // (brick, voxels, TF) are independent, so each hides the other's latency.
+        constexpr int W = Packet<N>::W, C = Packet<N>::C, G = C % 2 == 0 ? 2 : 1;
+        for (int k = 0; k < C; k += G) {
+            Vec3<G * W> col;
+            Packet<G * W> alpha, depth;
+            march<G * W>(s, group<G * W>(rays.org, k), group<G * W>(rays.dir, k), group<G * W>(rays.tMin, k),
+                         group<G * W>(rays.tMax, k), group<G * W>(active, k), col, alpha, depth, samples, skipped);
+            for (int j = 0; j < G; ++j) {
+                r.color.setChunk(k + j, col.chunk(j));
+                r.alpha.chunk(k + j) = alpha.chunk(j);
+                r.depth.chunk(k + j) = depth.chunk(j);
+            }
         }
         tlsCounters.volumeSamples += samples;
         tlsCounters.volumeSkipped += uint64_t(skipped);
         return r;
     }
 
+    // Native chunks k .. k + G/W - 1 of a packet, as one packet of G lanes.
+    template <int G, int N, class T>
+    static RTFACT_INLINE const Packet<G, T>& group(const Packet<N, T>& p, int k) {
+        return *reinterpret_cast<const Packet<G, T>*>(&p.c[k]);
+    }
+    template <int G, int N>
+    static RTFACT_INLINE const Mask<G>& group(const Mask<N>& m, int k) {
+        return *reinterpret_cast<const Mask<G>*>(&m.c[k]);
+    }
+    template <int G, int N>
+    static RTFACT_INLINE Vec3<G> group(const Vec3<N>& v, int k) {
+        return {group<G>(v.x, k), group<G>(v.y, k), group<G>(v.z, k)};
+    }
     template <int W>
-    static RTFACT_INLINE Packet<W, int32_t> shr3(const Packet<W, int32_t>& a) {
+    static RTFACT_INLINE Packet<W, int32_t> shiftRight(const Packet<W, int32_t>& a, int k) {
         Packet<W, int32_t> r;
-        for (int i = 0; i < Packet<W, int32_t>::C; ++i) r.c[i] = a.c[i] >> 3;
+        for (int i = 0; i < Packet<W, int32_t>::C; ++i) r.c[i] = a.c[i] >> k;
         return r;
     }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
@@ -55,7 +72,7 @@ struct VolumeIntegrator {
         const P fx = p.x - toFloat(ix), fy = p.y - toFloat(iy), fz = p.z - toFloat(iz);
         // brick of the cell, then the cell's first sample inside the brick
         static_assert(Scene::kCells == 8);
-        const I bx = shr3(ix), by = shr3(iy), bz = shr3(iz);
+        const I bx = shiftRight<W>(ix, 3), by = shiftRight<W>(iy, 3), bz = shiftRight<W>(iz, 3);
         const I start = haveStart ? *knownStart : gather(s.brickStart, bx + by * I(s.nbx) + bz * I(s.nbxy));
         const I base = start + (ix - bx * I(8)) + (iy - by * I(8)) * I(E) + (iz - bz * I(8)) * I(E * E);
         P a0, b0, a1, b1, a2, b2, a3, b3;
@@ -109,6 +126,7 @@ struct VolumeIntegrator {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
         const VolumeMode mode = s.settings.mode;
+        const bool adaptive = (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) && s.settings.maxStepMultiple > 1;
         // Rays into index space; t stays the world distance.
         const Vec3<W> oi = (o - Vec3<W>(s.origin)) * Vec3<W>(s.invSpacing);
         const Vec3<W> di = d * Vec3<W>(s.invSpacing);
@@ -160,26 +178,37 @@ struct VolumeIntegrator {
             Mask<W> samp = alive;
             I start(0);
             bool haveStart = false;
-            // Empty-space skipping: jump to the first sample position past the cell.
+            P mStep(1.0f);  // step multiple of the lanes' bricks (opacity-adaptive steps)
+            I tfOffset(0);  // their TF table, in pairs of floats
+            // Empty-space skipping: jump to the first sample position past the empty cube of
+            // bricks around the lane's brick (one brick for MIP).
             {
                 I c[3];
                 for (int a = 0; a < 3; ++a) c[a] = min(toInt(p[a] * P(invCell)), cellHi[a]);
                 const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
                 Mask<W> empty;
+                I reach(1);  // empty cube radius + 1, in bricks
                 if (mode == VolumeMode::MIP) {
                     empty = alive & (gather(s.cellMax.data(), cid) <= maxv);
                 } else {
-                    // one gather gives the brick and (sign bit) whether it is empty
+                    // one gather gives the brick, its step multiple, or (sign bit) the
+                    // distance to the nearest brick that is not skipped
                     const I info = gather(s.brickInfo.data(), cid);
                     empty = alive & (info < I(0));
-                    start = info & I(0x7fffffff);
+                    start = (info & I(Scene::kPoolMask)) * I(Scene::kBrick);
                     haveStart = true;
+                    if (adaptive) {
+                        const I l = shiftRight<W>(info, 28) & I(3);
+                        mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));
+                        tfOffset = l * I(2 * s.tf.size);
+                    }
+                    reach = info & I(0x7fffffff);
                 }
                 if (any(empty)) {
                     P tExit(kInfinity);
                     for (int a = 0; a < 3; ++a) {
-                        const P bound = toFloat(c[a] + select(di[a] > P(0.0f), I(1), I(0))) * P(float(Scene::kCells));
-                        tExit = min(tExit, (bound - oi[a]) * inv[a]);
+                        const I side = select(di[a] > P(0.0f), c[a] + reach, c[a] + I(1) - reach);
+                        tExit = min(tExit, (toFloat(side) * P(float(Scene::kCells)) - oi[a]) * inv[a]);
                     }
                     const P kk = max(-floor(-((tExit - tNear) * invDt - P(0.5f))), kf + P(1.0f));
                     const P tn = tNear + (kk + P(0.5f)) * dt;
@@ -197,12 +226,13 @@ struct VolumeIntegrator {
                     const I idx = tfIndex<W>(s, v);
                     // interleaved RGBA table: (b, a) first, (r, g) only if something is visible
                     P tb, ta;
-                    fetchFloatPair<W>(s.tf.rgba.data(), idx * I(2) + I(1), tb, ta);
+                    const I pair = idx * I(2) + tfOffset;
+                    fetchFloatPair<W>(s.rgbaSteps.data(), pair + I(1), tb, ta);
                     const P a = select(samp, ta, P(0.0f));
                     const Mask<W> contrib = a > P(0.0f);
                     if (any(contrib)) {
                         P tr, tg;
-                        fetchFloatPair<W>(s.tf.rgba.data(), idx * I(2), tr, tg);
+                        fetchFloatPair<W>(s.rgbaSteps.data(), pair, tr, tg);
                         Vec3<W> c(tr, tg, tb);
                         if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W>(s, p), d);
                         const P w = (P(1.0f) - alpha) * a;
@@ -242,7 +272,7 @@ struct VolumeIntegrator {
                     tPrev = select(samp, t, tPrev);
                     hasPrev = hasPrev | samp;
                 }
-                kf = select(samp, kf + P(1.0f), kf);
+                kf = select(samp, kf + mStep, kf);
                 t = select(samp, tNear + (kf + P(0.5f)) * dt, t);
             }
             alive = alive & (t < tFar);

@@ -24,6 +24,11 @@ struct VolumeRenderSettings {
     bool skipping = true;                    // empty-space skipping from the macrocells
     Vec3f clipLo{0, 0, 0}, clipHi{1, 1, 1};  // fractions of each axis
     float earlyTermination = 0.99f;
+    // Opacity-adaptive steps (DVR, shaded): a brick whose transfer-function opacity stays
+    // low is marched with 2 or 4 times the step, on the same sample lattice, as long as one
+    // longer step's opacity stays <= adaptiveOpacity. maxStepMultiple 1: the plain march.
+    int maxStepMultiple = 4;
+    float adaptiveOpacity = 0.01f;
     // Data-parallel ranks (docs/mpi.md): samples lie on the lattice that starts where the
     // ray enters this world box (the whole volume's clipped box), not the rank's own box,
     // so neighbouring slabs meet without seams.
@@ -34,7 +39,7 @@ struct VolumeRenderSettings {
 template <class T>
 struct VolumeScene {
     using Voxel = T;
-    static constexpr int kCells = BrickedVolume::kCells, kEdge = BrickedVolume::kEdge;
+    static constexpr int kCells = BrickedVolume::kCells, kEdge = BrickedVolume::kEdge, kBrick = BrickedVolume::kBrick;
     const T* voxels = nullptr;  // brick pool
     const int32_t* brickStart = nullptr;
     int dims[3] = {0, 0, 0};
@@ -51,7 +56,15 @@ struct VolumeScene {
     // Bricks are the macrocells: flags (non-zero = may contribute) for DVR/iso, maxima for MIP.
     int cells[3] = {0, 0, 0};
     std::vector<int32_t> cellFlags;
-    std::vector<int32_t> brickInfo;  // brick start, sign bit set when the brick is skipped
+    // Per brick, one load for the march. Skipped (sign bit set): the low bits hold the
+    // Chebyshev distance in bricks to the nearest brick that is not skipped (>= 1), so a
+    // ray jumps the whole empty cube around it. Otherwise: pool brick (start / kBrick) in
+    // bits 0-27, log2 of the step multiple in bits 28-29.
+    std::vector<int32_t> brickInfo;
+    static constexpr int32_t kSkipBit = int32_t(0x80000000u), kPoolMask = (1 << 28) - 1, kMaxDistance = 16;
+    // Transfer-function tables (interleaved r g b a) for 1, 2 and 4 steps: the opacity of
+    // table m is 1 - (1 - a)^m.
+    std::vector<float> rgbaSteps;
     std::vector<float> cellMax;
     float invCell = 1.0f / kCells;
 
@@ -94,7 +107,19 @@ struct VolumeScene {
             cellFlags[i] = (on || !s.skipping) ? 1 : 0;
         }
         brickInfo.resize(nc);
-        for (size_t i = 0; i < nc; ++i) brickInfo[i] = v.brickStart[i] | (cellFlags[i] ? 0 : int32_t(0x80000000u));
+        const std::vector<int32_t> multiple = stepMultiples(v);
+        const std::vector<int32_t> dist = emptyDistance();
+        for (size_t i = 0; i < nc; ++i) {
+            if (v.brickStart[i] / kBrick > kPoolMask) throw Error("", "volume too large for the brick table");
+            brickInfo[i] = cellFlags[i] ? (v.brickStart[i] / kBrick) | (multiple[i] << 28) : (kSkipBit | dist[i]);
+        }
+        rgbaSteps.resize(tf.rgba.size() * 3);
+        for (int m = 0; m < 3; ++m)
+            for (size_t e = 0; e < tf.rgba.size(); e += 4) {
+                float* d = &rgbaSteps[size_t(m) * tf.rgba.size() + e];
+                std::copy_n(&tf.rgba[e], 4, d);
+                d[3] = 1.0f - std::pow(1.0f - std::min(d[3], 1.0f), float(1 << m));
+            }
         // MIP skips on stored maxima; a decreasing value map (negative scale) or no
         // skipping: never skip.
         if (v.scale < 0 || !s.skipping)
@@ -102,6 +127,74 @@ struct VolumeScene {
     }
 
     AABB bounds() const { return {origin + boxLo * spacing, origin + boxHi * spacing}; }
+
+   private:
+    // log2 of each brick's step multiple: the largest m <= maxStepMultiple whose m-step
+    // opacity 1 - (1 - a)^m stays <= adaptiveOpacity for every TF entry the brick's value
+    // range reaches. Bricks the TF leaves invisible keep m = 1, so that a march without
+    // skipping reaches the same sample positions as one that skips them.
+    std::vector<int32_t> stepMultiples(const BrickedVolume& v) const {
+        std::vector<int32_t> out(v.brickCount(), 0);
+        const bool dvr = settings.mode == VolumeMode::DVR || settings.mode == VolumeMode::Shaded;
+        if (!dvr || settings.maxStepMultiple < 2) return out;
+        // per multiple, prefix counts of table entries too opaque for it
+        std::vector<int32_t> tooOpaque[3];
+        for (int m = 1; m < 3 && (1 << m) <= settings.maxStepMultiple; ++m) {
+            const float limit = 1.0f - std::pow(1.0f - settings.adaptiveOpacity, 1.0f / float(1 << m));
+            tooOpaque[m].assign(size_t(tf.size) + 1, 0);
+            for (int e = 0; e < tf.size; ++e)
+                tooOpaque[m][size_t(e) + 1] = tooOpaque[m][size_t(e)] + (tf.a[size_t(e)] > limit ? 1 : 0);
+        }
+        for (size_t i = 0; i < out.size(); ++i) {
+            const float lo = v.cellLo[i] * v.scale + v.offset, hi = v.cellHi[i] * v.scale + v.offset;
+            if (!tf.visible(std::min(lo, hi), std::max(lo, hi))) continue;
+            int i0 = tf.index(lo), i1 = tf.index(hi);
+            if (i0 > i1) std::swap(i0, i1);
+            for (int m = 2; m >= 1; --m)
+                if (!tooOpaque[m].empty() && tooOpaque[m][size_t(i1) + 1] == tooOpaque[m][size_t(i0)]) {
+                    out[i] = m;
+                    break;
+                }
+        }
+        return out;
+    }
+    // Chebyshev distance (in bricks, capped at kMaxDistance) from each skipped brick to the
+    // nearest brick that is not: all bricks closer than that are skipped too. Grows the
+    // non-skipped set one brick per pass (separable 3x3x3 dilation).
+    std::vector<int32_t> emptyDistance() const {
+        const int n[3] = {cells[0], cells[1], cells[2]};
+        const size_t nc = size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
+        std::vector<int32_t> dist(nc, kMaxDistance);
+        std::vector<uint8_t> reached(nc), tmp(nc);
+        size_t left = 0;
+        for (size_t i = 0; i < nc; ++i) {
+            reached[i] = cellFlags[i] ? 1 : 0;
+            if (cellFlags[i])
+                dist[i] = 0;
+            else
+                ++left;
+        }
+        const size_t stride[3] = {1, size_t(n[0]), size_t(n[0]) * size_t(n[1])};
+        for (int d = 1; d < kMaxDistance && left > 0; ++d) {
+            for (int a = 0; a < 3; ++a) {
+                tmp = reached;
+                for (int z = 0; z < n[2]; ++z)
+                    for (int y = 0; y < n[1]; ++y)
+                        for (int x = 0; x < n[0]; ++x) {
+                            const int c[3] = {x, y, z};
+                            const size_t i = size_t(x) + size_t(y) * stride[1] + size_t(z) * stride[2];
+                            if ((c[a] > 0 && tmp[i - stride[a]]) || (c[a] + 1 < n[a] && tmp[i + stride[a]]))
+                                reached[i] = 1;
+                        }
+            }
+            for (size_t i = 0; i < nc; ++i)
+                if (reached[i] && dist[i] == kMaxDistance) {
+                    dist[i] = d;
+                    --left;
+                }
+        }
+        return dist;
+    }
 };
 
 // Calls f(const VolumeScene<T>&) with T the volume's storage type: the one place where

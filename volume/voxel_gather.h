@@ -1,5 +1,10 @@
 // Fetches two x-adjacent voxels per lane with one 32-bit gather for u8/u16 storage (the
-// grid is padded so the over-read stays in bounds); f32 needs two gathers.
+// grid is padded so the over-read stays in bounds); f32 needs two 64-bit gathers. The
+// load method is chosen per ISA at compile time, by measurement (docs/cli.md, Volumes):
+// hardware gathers on AVX-512 and AVX2 (on Zen 5 the AVX2 build's per-lane scalar loads,
+// one int-to-float conversion and insert per voxel, took most of the march), per-lane
+// loads for narrower or scalar packets. Packets of several native chunks are fetched
+// chunk by chunk.
 #pragma once
 #include <cstring>
 #include <type_traits>
@@ -23,9 +28,42 @@ RTFACT_INLINE __m256i highHalf(simd::nvec<int32_t, 16> v) {
 }
 #endif
 
+#if RTFACT_NATIVE_WIDTH == 8
+RTFACT_INLINE __m128i lowHalf8(simd::nvec<int32_t, 8> v) { return _mm256_castsi256_si128((__m256i)v); }
+RTFACT_INLINE __m128i highHalf8(simd::nvec<int32_t, 8> v) { return _mm256_extracti128_si256((__m256i)v, 1); }
+// Four (even, odd) float pairs from each of two 64-bit gathers -> the even and the odd floats.
+RTFACT_INLINE void splitPairs8(__m256 lo, __m256 hi, simd::nvec<float, 8>& even, simd::nvec<float, 8>& odd) {
+    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+    const __m256 l = _mm256_permutevar8x32_ps(lo, order), h = _mm256_permutevar8x32_ps(hi, order);
+    even = (simd::nvec<float, 8>)_mm256_permute2f128_ps(l, h, 0x20);
+    odd = (simd::nvec<float, 8>)_mm256_permute2f128_ps(l, h, 0x31);
+}
+#endif
+
 template <class T, int W>
 RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packet<W>& a, Packet<W>& b) {
     using namespace simd;
+    if constexpr (Packet<W>::C > 1) {
+        for (int k = 0; k < Packet<W>::C; ++k) fetchPair<T, Packet<W>::W>(base, idx.chunk(k), a.chunk(k), b.chunk(k));
+        return;
+    }
+#if RTFACT_NATIVE_WIDTH == 8
+    if constexpr (W == 8) {
+        if constexpr (sizeof(T) < 4) {
+            const __m256i g = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], int(sizeof(T)));
+            const __m256i m = _mm256_set1_epi32(sizeof(T) == 1 ? 0xFF : 0xFFFF);
+            a.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, m));
+            b.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(g, 8 * sizeof(T)), m));
+        } else {
+            const __m256 lo =
+                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, lowHalf8(idx.c[0]), 4));
+            const __m256 hi =
+                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, highHalf8(idx.c[0]), 4));
+            splitPairs8(lo, hi, a.c[0], b.c[0]);
+        }
+        return;
+    }
+#endif
 #if RTFACT_NATIVE_WIDTH >= 16
     if constexpr (W == 16) {
         __m512i g = _mm512_setzero_si512();
@@ -73,6 +111,19 @@ RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packe
 // gathers on AVX-512 (half the gathered elements of two 32-bit gathers).
 template <int W>
 RTFACT_INLINE void fetchFloatPair(const float* base, const Packet<W, int32_t>& idx2, Packet<W>& a, Packet<W>& b) {
+    if constexpr (Packet<W>::C > 1) {
+        for (int k = 0; k < Packet<W>::C; ++k)
+            fetchFloatPair<Packet<W>::W>(base, idx2.chunk(k), a.chunk(k), b.chunk(k));
+        return;
+    }
+#if RTFACT_NATIVE_WIDTH == 8
+    if constexpr (W == 8) {
+        const __m256 lo = _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, lowHalf8(idx2.c[0]), 8));
+        const __m256 hi = _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, highHalf8(idx2.c[0]), 8));
+        splitPairs8(lo, hi, a.c[0], b.c[0]);
+        return;
+    }
+#endif
 #if RTFACT_NATIVE_WIDTH >= 16
     if constexpr (W == 16) {
         const __m512 lo = _mm512_castsi512_ps(
