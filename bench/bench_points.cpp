@@ -1,5 +1,5 @@
-// rtfact-bench points FILE: RTfact's LoD disc tracer (full detail and LoD; the wide
-// BVH of disc blocks, or with --accel kd the LoD kd-tree) against Embree 3 oriented-disc points
+// rtfact-bench points FILE: RTfact's LoD disc tracer (full detail and LoD; the LoD
+// kd-tree, or with --accel wide the wide BVH of disc blocks) against Embree 3 oriented-disc points
 // (RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT) with the same centres, normals (decoded from RTfact's quantised ones) and
 // radii, the same camera rays and thread counts, in one process. Embree runs in its best mode for coherent primary
 // rays: rtcIntersect16 on 4x4 pixel blocks, coherent context flag, medium build. Both sides do the same per-pixel work:
@@ -269,7 +269,7 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
 
 int benchPoints(int argc, char** argv) {
     CLI::App app{"RTfact LoD kd-tree discs vs Embree oriented-disc points", "rtfact-bench points"};
-    std::string file, eye, at, up, size = "1024x1024", normals = "auto", accel = "wide", split = "sah";
+    std::string file, eye, at, up, size = "1024x1024", normals = "auto", accel = "kd", split = "sah";
     float fov = 45.0f, radius = 0.0f, radiusFactor = 1.0f;
     std::vector<float> quality{1.0f}, repScale{0.7f};
     int threads = 0, packet = 16, repeat = 3, leafSize = 8;
@@ -293,7 +293,7 @@ int benchPoints(int argc, char** argv) {
                    "Hit radius of representatives / covering radius (more values: extra LoD runs)")
         ->capture_default_str()
         ->check(CLI::Range(0.1f, 1.0f));
-    app.add_option("--accel", accel, "RTfact structure: wide (the default) or kd (the LoD kd-tree)")
+    app.add_option("--accel", accel, "RTfact structure: kd (the LoD kd-tree, the default) or wide (BVH of disc blocks)")
         ->capture_default_str()
         ->check(CLI::IsMember({"wide", "kd"}));
     app.add_option("--wide-split", split, "Wide BVH build: sah (the default) or median (faster build)")
@@ -336,7 +336,7 @@ int benchPoints(int argc, char** argv) {
     frame.fovDeg = fov;
     const PinholeCamera cam(frame, w, h);
     std::shared_ptr<PointScene> scene = engine::builtPoints(sc, settings, frame);
-    if (accel == "kd" || split == "median") {  // the engine builds the default structure; others from its discs
+    if (accel == "wide") {  // the engine builds the default structure (kd); the wide one from its discs
         auto other = std::make_shared<PointScene>();
         other->accel = accel == "kd" ? PointAccel::KdTree : PointAccel::Wide;
         other->wideSplit = split == "median" ? LoDWideSplit::Median : LoDWideSplit::Sah;

@@ -105,19 +105,28 @@ const std::vector<std::string>& colormapNames() {
     return n;
 }
 
+namespace {
+const std::pair<const char*, ColorMode> kModeNames[] = {
+    {"auto", ColorMode::Auto},
+    {"rgb", ColorMode::Rgb},
+    {"elevation", ColorMode::Elevation},
+    {"intensity", ColorMode::Intensity},
+    {"classification", ColorMode::Classification},
+    {"return", ColorMode::Return},
+    {"lod", ColorMode::Lod},
+    {"normal", ColorMode::Normal},
+};
+}  // namespace
+
+std::string colorModeName(ColorMode mode) {
+    for (const auto& [n, m] : kModeNames)
+        if (m == mode) return n;
+    return "attr";
+}
+
 ColorOptions parseColorOptions(const std::string& s) {
     ColorOptions o;
-    static const std::pair<const char*, ColorMode> table[] = {
-        {"auto", ColorMode::Auto},
-        {"rgb", ColorMode::Rgb},
-        {"elevation", ColorMode::Elevation},
-        {"intensity", ColorMode::Intensity},
-        {"classification", ColorMode::Classification},
-        {"return", ColorMode::Return},
-        {"lod", ColorMode::Lod},
-        {"normal", ColorMode::Normal},
-    };
-    for (const auto& [n, m] : table)
+    for (const auto& [n, m] : kModeNames)
         if (s == n) {
             o.mode = m;
             return o;

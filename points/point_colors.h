@@ -28,6 +28,8 @@ struct ColorOptions {
 ColorOptions parseColorOptions(const std::string& s);
 // The names --color accepts (attr:NAME aside) and --colormap accepts.
 const std::vector<std::string>& colorModeNames();
+// The name parseColorOptions reads back as `mode` ("attr" for Attribute: add ":NAME").
+std::string colorModeName(ColorMode mode);
 const std::vector<std::string>& colormapNames();
 
 // A colormap at t in [0, 1] (clamped), linear RGB; throws Error("--colormap", ...) on an

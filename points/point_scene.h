@@ -24,11 +24,13 @@ inline Vec3f lodLevelColor(int level) {
 
 // Which structure a PointScene builds. Wide: one SIMD test per node for K children
 // and per block of 8 discs, child representatives beside the node (rtfact-bench points
-// --accel compares both). KdTree: binary, 16-ray packets, representatives in the node.
+// --accel compares both). KdTree: binary, 16-ray packets, representatives in the node;
+// the default: the wide BVH traces 1.2-1.5x faster but its SAH build is ~7x slower and
+// takes ~3x the memory (docs/benchmarks.md), too much for the clouds users load.
 enum class PointAccel { Wide, KdTree };
 
 struct PointScene {
-    PointAccel accel = PointAccel::Wide;         // set before build()
+    PointAccel accel = PointAccel::KdTree;       // set before build()
     LoDWideSplit wideSplit = LoDWideSplit::Sah;  // set before build()
     LoDKdTree tree;                              // PointAccel::KdTree
     LoDWideBVH wide;                             // PointAccel::Wide

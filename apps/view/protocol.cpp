@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/util/error.h"
+#include "points/point_colors.h"
 #include "points/point_prepare.h"
 
 namespace rtfact::viewer {
@@ -76,7 +77,8 @@ CameraFrame parseCamera(const json& j) {
     return c;
 }
 
-const std::vector<std::string> kColorModes = {"rgb", "intensity", "lod", "normal"};
+// The colour modes the page offers (every cloud has what these colour by).
+const std::vector<std::string> kColorModes = {"auto", "rgb", "elevation", "intensity", "lod", "normal"};
 const std::vector<std::string> kMaterials = {"default", "lambert", "mirror", "glass"};
 
 void applyPoints(const json& p, engine::PointSettings& s) {
@@ -233,8 +235,8 @@ json settingsJson(const engine::Settings& s, engine::SceneKind kind) {
     using K = engine::SceneKind;
     if (kind == K::Points) {
         const engine::PointSettings& p = s.points;
-        return {{"integrator", p.integrator}, {"color", kColorModes[size_t(p.color)]}, {"lod", p.lod},
-                {"lodQuality", p.lodQuality}, {"radiusFactor", p.radiusFactor},        {"aoSamples", p.aoSamples}};
+        return {{"integrator", p.integrator}, {"color", points::colorModeName(p.color)}, {"lod", p.lod},
+                {"lodQuality", p.lodQuality}, {"radiusFactor", p.radiusFactor},          {"aoSamples", p.aoSamples}};
     }
     if (kind == K::Volume) {
         const engine::VolumeSettings& v = s.volume;

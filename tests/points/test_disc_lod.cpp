@@ -181,7 +181,7 @@ TEST_P(LoDTraversal, QualityZeroEqualsBruteForce) {
 }
 INSTANTIATE_TEST_SUITE_P(LeafSizes, LoDTraversal, ::testing::Values(1, 4, 8, 16));
 
-// Full detail through the wide BVH of disc blocks (the default structure): the same
+// Full detail through the wide BVH of disc blocks (PointAccel::Wide): the same
 // hits as brute force at every packet width.
 TEST(DiscWideBVH, FullDetailEqualsBruteForce) {
     for (int n : {1, 7, 8, 9, 17, 3000})  // one partial block, one full, a block and one, three, many
@@ -189,6 +189,7 @@ TEST(DiscWideBVH, FullDetailEqualsBruteForce) {
             SCOPED_TRACE(n);
             SCOPED_TRACE(split == LoDWideSplit::Sah ? "sah" : "median");
             PointScene scene;
+            scene.accel = PointAccel::Wide;
             scene.wideSplit = split;
             std::vector<Disc> discs = randomDiscs(n, 12 + uint32_t(n));
             if (n < 100)
@@ -560,6 +561,7 @@ RepHitStats checkWideRepresentativeHits(const PointScene& scene, bool commonOrig
 TEST_P(DiscWideBVHSplit, ChildRepresentativesCoverTheirSubtrees) {
     const PointScene scene = [] {
         PointScene s;
+        s.accel = PointAccel::Wide;
         s.wideSplit = GetParam();
         s.build(randomDiscs(5000, 51));
         return s;
@@ -609,6 +611,7 @@ TEST_P(DiscWideBVHSplit, ChildRepresentativesCoverTheirSubtrees) {
 
 TEST_P(DiscWideBVHSplit, CoarseQualityAnswersWithRepresentatives) {
     PointScene vol;
+    vol.accel = PointAccel::Wide;
     vol.wideSplit = GetParam();
     vol.build(randomDiscs(4000, 41));
     std::vector<Disc> sphere = randomDiscs(4000, 42);
@@ -619,6 +622,7 @@ TEST_P(DiscWideBVHSplit, CoarseQualityAnswersWithRepresentatives) {
         d.radius = 0.06f;
     }
     PointScene surf;
+    surf.accel = PointAccel::Wide;
     surf.wideSplit = GetParam();
     surf.build(sphere);
     for (bool common : {true, false}) {

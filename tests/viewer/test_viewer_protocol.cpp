@@ -343,3 +343,20 @@ TEST(ViewerProtocol, SeveralTabsHaveTheirOwnViews) {
     const FrameMsg fb = b.frame([&](const json& m) { return sameCamera(m, cb); });
     EXPECT_NE(fa.bytes, fb.bytes);
 }
+
+// settingsJson names the colour mode applySettings reads back, for every mode the page
+// offers and for modes set from the command line (Auto, Classification): it once indexed
+// the page's short list with the enum and read past its end.
+TEST(ViewerProtocol, PointColourModesRoundTrip) {
+    const nlohmann::json choices = choicesJson(engine::SceneKind::Points);
+    ASSERT_TRUE(choices.contains("color"));
+    for (const auto& name : choices["color"]) {
+        engine::Settings s;
+        applySettings({{"points", {{"color", name}}}}, engine::SceneKind::Points, s);
+        EXPECT_EQ(settingsJson(s, engine::SceneKind::Points)["color"], name);
+    }
+    engine::Settings s;
+    EXPECT_EQ(settingsJson(s, engine::SceneKind::Points)["color"], "auto");
+    s.points.color = points::ColorMode::Classification;
+    EXPECT_EQ(settingsJson(s, engine::SceneKind::Points)["color"], "classification");
+}
