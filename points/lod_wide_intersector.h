@@ -183,12 +183,7 @@ struct LoDWideIntersector {
                         const int c = __builtin_ctzll(bits);
                         const Entry e{n.child[c], n.count[c], tn[c]};
                         if (e.count == 0) prefetchNode(bvh, e.child);
-                        int j = sp++;
-                        while (j > base && stack[j - 1].dist < e.dist) {
-                            stack[j] = stack[j - 1];
-                            --j;
-                        }
-                        stack[j] = e;
+                        pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                     }
                 }
             }

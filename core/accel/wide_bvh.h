@@ -247,4 +247,16 @@ BlockedWideBVH<Block, K> packLeafBlocks(WideBVHTopology<K>&& t, const Fill& fill
     return out;
 }
 
+// Traversal stacks: pushes `e` onto stack[base, sp) kept sorted far to near by `dist`, so
+// the nearest entry is popped first (the wide traversals' child order).
+template <class Entry>
+inline void pushSorted(Entry* stack, int& sp, int base, const Entry& e) {
+    int j = sp++;
+    while (j > base && stack[j - 1].dist < e.dist) {
+        stack[j] = stack[j - 1];
+        --j;
+    }
+    stack[j] = e;
+}
+
 }  // namespace rtfact

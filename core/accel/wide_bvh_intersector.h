@@ -196,13 +196,7 @@ struct WideBVHIntersector {
                         const int c = __builtin_ctzll(bits);
                         const Entry e{n.child[c], n.count[c], tn[c]};
                         if (e.count == 0) prefetchNode(nodes + e.child);
-                        // Far to near: the nearest ends on top.
-                        int j = sp++;
-                        while (j > base && stack[j - 1].dist < e.dist) {
-                            stack[j] = stack[j - 1];
-                            --j;
-                        }
-                        stack[j] = e;
+                        pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                     }
                 }
             }

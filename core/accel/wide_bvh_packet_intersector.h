@@ -290,13 +290,7 @@ struct WideBVHPacketIntersector {
                     stack[sp++] = e;
                 } else {
                     e.dist = hmin(select(m, tn, inf));
-                    // Far to near: the nearest ends on top.
-                    int j = sp++;
-                    while (j > base && stack[j - 1].dist < e.dist) {
-                        stack[j] = stack[j - 1];
-                        --j;
-                    }
-                    stack[j] = e;
+                    pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                 }
             }
             // Pop the nearest entry that can still hold a closer hit; run leaves and
