@@ -4,8 +4,11 @@
 #include <sys/types.h>
 
 #include <atomic>
+#include <string>
 
 #include "core/ray/ray_packet.h"
+#include "core/simd/native.h"
+#include "core/util/error.h"
 
 namespace rtfact::bench {
 
@@ -14,6 +17,27 @@ inline std::atomic<int64_t> gEmbreeBytes{0};
 inline bool embreeMemory(void*, ssize_t bytes, bool) {
     gEmbreeBytes += bytes;
     return true;
+}
+
+// Embree's widest code path at RTfact's build ISA: an avx2 (or sse4) build run on an
+// AVX-512 machine stands for an AVX2 (SSE4) CPU, where Embree's runtime dispatch could not
+// pick AVX-512 either; the native build leaves Embree free.
+inline const char* embreeMaxIsa() {
+    if constexpr (simd::kNativeWidth == 16)
+        return "avx512";
+    else if constexpr (simd::kNativeWidth == 8)
+        return "avx2";
+    else
+        return "sse4.2";
+}
+
+// A device with `threads` threads (0: all) and the ISA cap above.
+inline RTCDevice newEmbreeDevice(int threads) {
+    const std::string cfg = "threads=" + std::to_string(threads) + ",max_isa=" + embreeMaxIsa();
+    RTCDevice device = rtcNewDevice(cfg.c_str());
+    if (!device) throw Error("", "cannot create an Embree device (" + cfg + ")");
+    rtcSetDeviceMemoryMonitorFunction(device, embreeMemory, nullptr);
+    return device;
 }
 
 // Fills an Embree 16-ray hit structure from our packet (tnear 0, tfar infinite).

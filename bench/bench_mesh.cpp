@@ -268,12 +268,7 @@ struct EmbreeSide {
     RTCScene scene = nullptr;
     const Setup& s;
 
-    EmbreeSide(const Setup& setup, int threads) : s(setup) {
-        const std::string cfg = "threads=" + std::to_string(threads);
-        device = rtcNewDevice(cfg.c_str());
-        if (!device) throw Error("", "cannot create an Embree device");
-        rtcSetDeviceMemoryMonitorFunction(device, embreeMemory, nullptr);
-    }
+    EmbreeSide(const Setup& setup, int threads) : s(setup) { device = newEmbreeDevice(threads); }
     ~EmbreeSide() {
         if (scene) rtcReleaseScene(scene);
         rtcReleaseDevice(device);
@@ -419,6 +414,7 @@ uint64_t countHits(const Frame& f) {
 template <int N>
 int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat,
         int secSamples, bool wideVariants, float singleNode, float singleLeaf) {
+    std::printf("cpu: %s, isa %s (Embree capped at %s)\n", cpuModel().c_str(), simd::isaName(), embreeMaxIsa());
     std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w,
                 h, N, allThreads);
     auto meshPtr = std::make_shared<const Mesh>(mesh);

@@ -89,10 +89,7 @@ struct EmbreeSide {
     const PinholeCamera& cam;
 
     EmbreeSide(const std::vector<Disc>& d, const PinholeCamera& c, int threads) : discs(d), cam(c) {
-        const std::string cfg = "threads=" + std::to_string(threads);
-        device = rtcNewDevice(cfg.c_str());
-        if (!device) throw Error("", "cannot create an Embree device");
-        rtcSetDeviceMemoryMonitorFunction(device, embreeMemory, nullptr);
+        device = newEmbreeDevice(threads);
     }
     ~EmbreeSide() {
         if (scene) rtcReleaseScene(scene);
@@ -175,6 +172,7 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
     PointScene& scene = *built;
     std::vector<Disc> discs = scene.discs();
     const size_t n = discs.size();
+    std::printf("cpu: %s, isa %s (Embree capped at %s)\n", cpuModel().c_str(), simd::isaName(), embreeMaxIsa());
     std::printf(
         "file=%s\npoints=%zu\naccel=%s%s\nimage=%dx%d\npacket=%d\nthreads_all=%d\nlod_quality=%.3g\nrep_scale=%."
         "3g\nload_"
