@@ -1,6 +1,5 @@
 #include "core/render/image_io.h"
 
-#include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -8,9 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <random>
 
 #include "core/io/file_helpers.h"
+#include "core/render/image_codec.h"
 #include "core/render/srgb.h"
 #include "core/util/error.h"
 #include "core/util/input_file.h"
@@ -24,7 +25,7 @@ namespace {
 
 using io::lowerExt;
 
-// libpng and libjpeg print their own diagnostics on stderr before OIIO reports the
+// libpng and libjpeg print their own diagnostics on stderr before the codec reports the
 // failure; while an input image is decoded stderr goes to /dev/null, so that the user
 // sees our one-line error only. (Images are read before rendering starts: no other
 // thread is writing to stderr then.)
@@ -89,33 +90,22 @@ void writeImage(const std::string& path, int width, int height, const std::vecto
     const std::string tmp = tempPathFor(path);
     const bool floats = isFloatFormat(ext);
     const int channels = floats ? 4 : 3;  // 8-bit images carry the background-composited colour
-    auto out = OIIO::ImageOutput::create(tmp);
-    if (!out) throw Error(path, "cannot create image writer: " + oneLine(OIIO::geterror()));
-    OIIO::ImageSpec spec(width, height, channels, floats ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-    if (!floats) spec.attribute("oiio:ColorSpace", "sRGB");
-    bool ok = out->open(tmp, spec);
-    if (ok) {
-        if (floats) {
-            ok = out->write_image(OIIO::TypeDesc::FLOAT, rgba.data());
-        } else {
-            std::vector<unsigned char> px(size_t(width) * size_t(height) * size_t(channels));
-            for (size_t i = 0, n = size_t(width) * size_t(height); i < n; ++i) {
-                for (int c = 0; c < channels; ++c) {
-                    px[i * size_t(channels) + size_t(c)] = linearToSrgb8(rgba[i * 4 + size_t(c)]);
-                }
-            }
-            ok = out->write_image(OIIO::TypeDesc::UINT8, px.data());
+    const ImageCodec& codec = imageCodec(path);
+    std::vector<unsigned char> px;
+    if (!floats) {
+        px.resize(size_t(width) * size_t(height) * size_t(channels));
+        for (size_t i = 0, n = size_t(width) * size_t(height); i < n; ++i) {
+            for (int c = 0; c < channels; ++c)
+                px[i * size_t(channels) + size_t(c)] = linearToSrgb8(rgba[i * 4 + size_t(c)]);
         }
-        ok = out->close() && ok;
     }
-    if (!ok) {
-        const std::string err = oneLine(out->geterror());
-        out.reset();
+    std::string err;
+    if (!codec.write(tmp, width, height, channels, floats, floats ? static_cast<const void*>(rgba.data()) : px.data(),
+                     err)) {
         std::error_code ec;
         fs::remove(tmp, ec);
-        throw Error(path, "cannot write image: " + err);
+        throw Error(path, "cannot write image: " + oneLine(err));
     }
-    out.reset();
     std::error_code ec;
     fs::rename(tmp, path, ec);
     if (ec) {
@@ -130,18 +120,20 @@ Image readImage(const std::string& path) {
     requireRegularFile(path);  // a named pipe would block the image reader
     const uint64_t fileBytes = fs::file_size(path, ec);
     if (ec || fileBytes == 0) throw Error(path, "empty image file");
+    const ImageCodec& codec = imageCodec(path);
     SilenceStderr quiet;
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path, "cannot read image: " + oneLine(OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.nchannels > 64 || spec.depth > 1)
+    ImageHeader spec;
+    std::string err;
+    std::unique_ptr<void, void (*)(void*)> in(codec.open(path, spec, err), codec.close);
+    if (!in) throw Error(path, "cannot read image: " + oneLine(err));
+    if (spec.width <= 0 || spec.height <= 0 || spec.channels <= 0 || spec.channels > 64 || spec.depth > 1)
         throw Error(path, "unsupported image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                              "x" + std::to_string(spec.depth) + " with " + std::to_string(spec.nchannels) +
+                              "x" + std::to_string(spec.depth) + " with " + std::to_string(spec.channels) +
                               " channels");
     // A lying header must not make us allocate: no format we read compresses better than
     // deflate's 1032:1, so 4096 decoded bytes per file byte is a generous bound.
-    const uint64_t decoded = uint64_t(spec.width) * uint64_t(spec.height) * uint64_t(spec.nchannels);
-    if (decoded * spec.format.size() / 4096 > fileBytes)
+    const uint64_t decoded = uint64_t(spec.width) * uint64_t(spec.height) * uint64_t(spec.channels);
+    if (decoded * spec.formatBytes / 4096 > fileBytes)
         throw Error(path, "image header claims " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
                               " pixels, more than a file of " + std::to_string(fileBytes) + " bytes can hold");
     checkMemory(path, decoded * sizeof(float),
@@ -150,13 +142,13 @@ Image readImage(const std::string& path) {
     Image img;
     img.width = spec.width;
     img.height = spec.height;
-    img.channels = spec.nchannels;
+    img.channels = spec.channels;
     img.pixels.resize(size_t(decoded));
-    if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
-        throw Error(path, "cannot decode image: " + oneLine(in->geterror()));
+    if (!codec.read(in.get(), img.channels, img.pixels.data(), err))
+        throw Error(path, "cannot decode image: " + oneLine(err));
     for (float v : img.pixels)
         if (!std::isfinite(v)) throw Error(path, "image holds NaN or infinite values");
-    if (spec.format == OIIO::TypeDesc::UINT8) {
+    if (spec.uint8) {
         for (size_t i = 0; i < img.pixels.size(); ++i)
             if (img.channels < 4 || i % size_t(img.channels) != 3) img.pixels[i] = srgbToLinear(img.pixels[i]);
     }

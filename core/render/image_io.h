@@ -1,5 +1,5 @@
-// Image files through OpenImageIO; the format follows the extension (PNG, EXR, TIFF,
-// JPEG). Writes go to a temporary file in the same directory that is renamed into
+// Image files through OpenImageIO (loaded on first use: image_codec.h); the format follows
+// the extension (PNG, EXR, TIFF, JPEG). Writes go to a temporary file in the same directory that is renamed into
 // place, so a failed run never leaves a half-written image.
 #pragma once
 #include <string>
