@@ -54,6 +54,20 @@ enum Figure { kLoadMs, kRenderMs, kCompositeMs, kBytes, kLoaded, kHwm, kGhosts, 
 int runMpiPointData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine::Settings()>& settings,
                     const DataSource& data);
 
+// Every rank parses the options into `s`, `check` rejects what this data-parallel mode
+// cannot render (a usage error), rank 0 checks the output path; a rank that fails ends
+// them all. Returns the exit status to stop with, 0 to go on.
+int agreeOnOptions(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine::Settings()>& settings,
+                   engine::Settings& s, const std::function<void(const engine::Settings&)>& check) {
+    if (mpi.rank != 0) c.quiet = true;
+    return mpi.agree(attempt([&] {
+        c.finalize();
+        s = settings();
+        check(s);
+        if (mpi.rank == 0) checkImageWritable(c.out);
+    }));
+}
+
 }  // namespace
 
 std::string chooseDistribution(const CommonOptions& c, const DataSource* data, int ranks) {
@@ -83,20 +97,16 @@ int runMpiData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine
                const DataSource& data) {
     if (data.kind == engine::SceneKind::Points) return runMpiPointData(mpi, c, settings, data);
     const bool root = mpi.rank == 0;
-    if (!root) c.quiet = true;
     engine::Settings s;
     engine::VolumePart part;
     double fig[kFigures] = {};
     // Options first, then each rank reads its slab; a rank that cannot ends them all.
-    if (int st = mpi.agree(attempt([&] {
-            c.finalize();
-            s = settings();
-            if (s.volume.mode != "dvr" && s.volume.mode != "shaded")
-                throw engine::UsageError("--mode", s.volume.mode +
+    if (int st = agreeOnOptions(mpi, c, settings, s, [](const engine::Settings& o) {
+            if (o.volume.mode != "dvr" && o.volume.mode != "shaded")
+                throw engine::UsageError("--mode", o.volume.mode +
                                                        " is not composited across slabs yet: --distribute data "
                                                        "renders dvr and shaded; use --distribute image");
-            if (root) checkImageWritable(c.out);
-        })))
+        }))
         return st;
     const auto t0 = std::chrono::steady_clock::now();
     if (int st = mpi.agree(attempt([&] {
@@ -196,21 +206,17 @@ namespace {
 int runMpiPointData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine::Settings()>& settings,
                     const DataSource& data) {
     const bool root = mpi.rank == 0;
-    if (!root) c.quiet = true;
     engine::Settings s;
     distributed::PointPart part;
     double fig[kFigures] = {};
-    if (int st = mpi.agree(attempt([&] {
-            c.finalize();
-            s = settings();
+    if (int st = agreeOnOptions(mpi, c, settings, s, [](const engine::Settings& o) {
             // Lights placed from the cloud's box (direct, whitted) and rays that meet other
             // parts' points (ao, path) need the whole cloud.
-            if (s.points.integrator != "eyelight")
-                throw engine::UsageError("--integrator", s.points.integrator +
+            if (o.points.integrator != "eyelight")
+                throw engine::UsageError("--integrator", o.points.integrator +
                                                              ": --distribute data renders point clouds with eyelight; "
                                                              "use --distribute image");
-            if (root) checkImageWritable(c.out);
-        })))
+        }))
         return st;
     if (int st = mpi.agree(attempt([&] {
             engine::OpenOptions o = data.options();
