@@ -1,11 +1,9 @@
 // rtfact: one command line for every renderer. It parses, loads, composes, renders and
 // writes; the work lives in the libraries.
 #include <cstdio>
-#include <exception>
 
 #include "apps/rtfact/commands.h"
-#include "core/util/error.h"
-#include "engine/usage_error.h"
+#include "apps/rtfact/outcome.h"
 
 int main(int argc, char** argv) {
     using namespace rtfact::app;
@@ -31,20 +29,10 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "rtfact: error: %s\n(see rtfact --help)\n", e.what());
-        return 2;
-    } catch (const rtfact::engine::UsageError& e) {
-        std::fprintf(stderr, "rtfact: error: %s\n(see rtfact --help)\n", e.message().c_str());
-        return 2;
-    } catch (const rtfact::Error& e) {
-        std::fprintf(stderr, "rtfact: error: %s\n", e.message().c_str());
-        return 1;
-    } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "rtfact: error: out of memory\n");
-        return 1;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "rtfact: error: %s\n", e.what());
-        return 1;
+    } catch (...) {
+        // Usage errors point to the help; the rest is one line naming the source.
+        const Outcome o = currentOutcome();
+        std::fprintf(stderr, "rtfact: error: %s\n%s", o.message.c_str(), o.status == 2 ? "(see rtfact --help)\n" : "");
+        return o.status;
     }
 }

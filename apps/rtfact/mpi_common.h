@@ -9,36 +9,14 @@
 #include <string>
 
 #include "apps/rtfact/common_options.h"
+#include "apps/rtfact/outcome.h"
 #include "core/util/error.h"
 #include "engine/usage_error.h"
 
 namespace rtfact::app::mpi {
 
-// What a step ended with on this rank: 0, or the exit status and its message.
-struct Outcome {
-    int status = 0;
-    std::string message;
-};
-
-// Runs `f`, turning its exceptions into the exit status main() would give them.
-template <class F>
-Outcome attempt(F&& f) {
-    Outcome o;
-    try {
-        f();
-    } catch (const CLI::ParseError& e) {
-        o = {2, e.what()};
-    } catch (const engine::UsageError& e) {
-        o = {2, e.message()};
-    } catch (const Error& e) {
-        o = {1, e.message()};
-    } catch (const std::bad_alloc&) {
-        o = {1, "out of memory"};
-    } catch (const std::exception& e) {
-        o = {1, e.what()};
-    }
-    return o;
-}
+using app::attempt;
+using app::Outcome;
 
 class Mpi {
    public:
