@@ -6,6 +6,7 @@
 #pragma once
 #include "core/accel/wide_bvh.h"
 #include "points/disc_intersector.h"
+#include "points/ray_disc_plane.h"
 
 namespace rtfact::points {
 
@@ -83,16 +84,9 @@ struct DiscBlockIntersector {
     template <int L>
     static RTFACT_INLINE auto blockTest(const DiscBlock<L>& b, const RayPacket<1>& ray, float tFar, Packet<L>& t) {
         using P = Packet<L>;
-        const P cx = P::load(b.c[0]) - P(ray.org.x[0]), cy = P::load(b.c[1]) - P(ray.org.y[0]),
-                cz = P::load(b.c[2]) - P(ray.org.z[0]);
-        const P nx = P::load(b.n[0]), ny = P::load(b.n[1]), nz = P::load(b.n[2]);
-        const P dx(ray.dir.x[0]), dy(ray.dir.y[0]), dz(ray.dir.z[0]);
-        const P num = cx * nx + cy * ny + cz * nz;
-        const P den = dx * nx + dy * ny + dz * nz;
-        t = num / den;  // +-inf or NaN for parallel rays: every comparison below fails
-        const P px = dx * t - cx, py = dy * t - cy, pz = dz * t - cz;
-        const P dist2 = px * px + py * py + pz * pz;
-        return (dist2 <= P::load(b.r2)) & (t > P(float(ray.tMin))) & (t < P(tFar));
+        const RayDiscPlane<L> h = rayDiscPlane(b.c, b.n, ray);
+        t = h.t;
+        return (h.dist2 <= P::load(b.r2)) & (t > P(float(ray.tMin))) & (t < P(tFar));
     }
 };
 static_assert(ElementIntersector<DiscBlockIntersector, Disc>);

@@ -12,6 +12,7 @@
 #include "core/concepts/intersector.h"
 #include "core/util/assert.h"
 #include "points/lod_wide_bvh.h"
+#include "points/ray_disc_plane.h"
 
 namespace rtfact::points {
 
@@ -73,15 +74,7 @@ struct LoDWideIntersector {
     RTFACT_INLINE bool cutChildren(const LoDChildReps<K>& r, int32_t node, uint64_t cut, const RayPacket<1>& ray,
                                    Hit<1>& hit) const {
         const P rr = P::load(r.radius) * P(repScale);
-        const P cx = P::load(r.c[0]) - P(ray.org.x[0]), cy = P::load(r.c[1]) - P(ray.org.y[0]),
-                cz = P::load(r.c[2]) - P(ray.org.z[0]);
-        const P nx = P::load(r.n[0]), ny = P::load(r.n[1]), nz = P::load(r.n[2]);
-        const P dx(ray.dir.x[0]), dy(ray.dir.y[0]), dz(ray.dir.z[0]);
-        const P num = cx * nx + cy * ny + cz * nz;
-        const P den = dx * nx + dy * ny + dz * nz;
-        const P t = num / den;
-        const P px = dx * t - cx, py = dy * t - cy, pz = dz * t - cz;
-        const P dist2 = px * px + py * py + pz * pz;
+        const auto [t, dist2] = rayDiscPlane(r.c, r.n, ray);
         uint64_t m = BitMask<K>((dist2 <= rr * rr) & (t > P(float(ray.tMin))) & (t < P(float(hit.t)))).w[0] & cut;
         if (!m) return false;
         if constexpr (AnyHit) {
