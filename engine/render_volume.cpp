@@ -58,6 +58,7 @@ VolumeSetup resolveVolumeSetup(const BrickedVolume& vol, const VolumeSettings& s
     rs.mode = modeOf(s.mode);
     rs.stepVoxels = s.step;
     rs.skipping = s.skipping;
+    if (!s.adaptiveSteps) rs.maxStepMultiple = 1;
     rs.clipLo = s.clipLo;
     rs.clipHi = s.clipHi;
     if (s.lattice) {

@@ -59,6 +59,9 @@ struct VolumeSettings {
     float step = 0.5f;                           // voxels
     Vec3f clipLo{0, 0, 0}, clipHi{1, 1, 1};      // fractions of each axis
     bool skipping = true;
+    // Opacity-adaptive steps (dvr, shaded): bricks of low opacity are marched with 2 or 4
+    // times the step on the same sample lattice; off: the plain march.
+    bool adaptiveSteps = true;
     // Data-parallel ranks: samples on the lattice of this world box (docs/mpi.md).
     std::optional<AABB> lattice;
 };

@@ -128,7 +128,8 @@ const std::set<std::string>& namesOf(SceneKind k) {
                                               "radius",     "radius_factor", "leaf_size", "ao_samples"};
     static const std::set<std::string> mesh{"integrator", "max_depth",  "light",    "material",
                                             "bvh",        "ao_samples", "secondary"};
-    static const std::set<std::string> volume{"tf", "mode", "iso", "step", "window", "level", "clip", "no_skip"};
+    static const std::set<std::string> volume{
+        "tf", "mode", "iso", "step", "window", "level", "clip", "no_skip", "no_adaptive_steps"};
     static const std::set<std::string> spheres{"integrator"};
     switch (k) {
         case SceneKind::Points:
@@ -180,6 +181,7 @@ void applyVolume(engine::VolumeSettings& s, const std::string& k, py::handle v) 
     if (k == "level") s.level = float(number(v, k));
     if (k == "clip") clipArg(v, s);
     if (k == "no_skip") s.skipping = !flag(v, k);
+    if (k == "no_adaptive_steps") s.adaptiveSteps = !flag(v, k);
 }
 
 }  // namespace

@@ -64,12 +64,15 @@ void VolumeOptions::addTo(CLI::App& cmd) {
             },
             "AXIS:LO:HI"));
     cmd.add_flag("--no-skip", noSkip, "Disable empty-space skipping (for comparisons)");
+    cmd.add_flag("--no-adaptive-steps", noAdaptiveSteps,
+                 "March low-opacity bricks with the plain step too (no 2x/4x steps)");
 }
 
 engine::Settings VolumeOptions::toSettings() const {
     engine::Settings s;
     s.volume = settings;
     s.volume.skipping = !noSkip;
+    s.volume.adaptiveSteps = !noAdaptiveSteps;
     for (const std::string& cl : clips) engine::applyClipText(cl, s.volume, "--clip");
     // --tf is read before the volume so that a bad file fails fast; without it the
     // engine chooses the default from the data.

@@ -21,6 +21,7 @@ struct VolumeOptions {
     engine::VolumeSettings settings;
     std::vector<std::string> clips;
     bool noSkip = false;
+    bool noAdaptiveSteps = false;
 
     void addTo(CLI::App& cmd);
     // The settings the parsed options give (reads a --tf file).
