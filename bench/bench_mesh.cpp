@@ -411,9 +411,15 @@ uint64_t countHits(const Frame& f) {
     return uint64_t(std::count_if(f.t.begin(), f.t.end(), [](float t) { return t < kInfinity; }));
 }
 
+// Wide packet traversal tuning from the command line (negative: the library's default).
+struct WideTuning {
+    float singleNode = -1.0f, singleLeaf = -1.0f;
+    int packetSplit = -1;
+};
+
 template <int N>
 int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat,
-        int secSamples, bool wideVariants, float singleNode, float singleLeaf) {
+        int secSamples, bool wideVariants, const WideTuning& tune) {
     std::printf("cpu: %s, isa %s (Embree capped at %s)\n", cpuModel().c_str(), simd::isaName(), embreeMaxIsa());
     std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w,
                 h, N, allThreads);
@@ -426,8 +432,9 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     scene.mesh = pscene.mesh = meshPtr;
     scene.packetBVH = false;
     pscene.buildWide = false;
-    if (singleNode >= 0.0f) scene.widePacketTracer.isect.singleRayFraction = singleNode;
-    if (singleLeaf >= 0.0f) scene.widePacketTracer.isect.singleRayLeafFraction = singleLeaf;
+    if (tune.singleNode >= 0.0f) scene.widePacketTracer.isect.singleRayFraction = tune.singleNode;
+    if (tune.singleLeaf >= 0.0f) scene.widePacketTracer.isect.singleRayLeafFraction = tune.singleLeaf;
+    if (tune.packetSplit >= 0) scene.widePacketTracer.isect.packetSplit = tune.packetSplit;
     double rtBuild[2] = {1e30, 1e30}, emBuild[2] = {1e30, 1e30}, packetBuild[2] = {1e30, 1e30};
     std::unique_ptr<EmbreeSide> em;
     for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
@@ -494,17 +501,24 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     }
     // The same primary rays one by one through the wide BVH (not part of the ratios):
     // what the packet traversal's single-ray hand-over can reach on far views.
+    // And the packet traversal with every chunk starting at the root (packetSplit 0):
+    // what the whole packet's traversal of the top levels gains.
+    const int split = scene.widePacketTracer.isect.packetSplit;
     for (int T : threadCounts) {
-        Result rw, rp;
+        Result rw, rp, r0;
         Frame fw(w, h);
         for (int r = 0; r < repeat; ++r) {
             rp.ms = std::min(rp.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fw, x, y, false); }));
             rw.ms = std::min(rw.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fw, x, y, true); }));
+            scene.widePacketTracer.isect.packetSplit = 0;
+            r0.ms = std::min(r0.ms, timeTiles(T, w, h, [&](int x, int y) { rt.primaryTile(fw, x, y, false); }));
+            scene.widePacketTracer.isect.packetSplit = split;
         }
-        rw.rays = rp.rays = uint64_t(w) * h;
+        rw.rays = rp.rays = r0.rays = uint64_t(w) * h;
         std::printf(
-            "threads=%d primary_mrays: rtfact_wide_packet=%.2f rtfact_wide_single=%.2f ratio_single_vs_packet=%.3f\n",
-            T, rp.mrays(), rw.mrays(), rw.mrays() / rp.mrays());
+            "threads=%d primary_mrays: rtfact_wide_packet=%.2f rtfact_wide_single=%.2f ratio_single_vs_packet=%.3f "
+            "rtfact_wide_from_root=%.2f ratio_packet_vs_from_root=%.3f (packet split %d)\n",
+            T, rp.mrays(), rw.mrays(), rw.mrays() / rp.mrays(), r0.mrays(), rp.mrays() / r0.mrays(), split);
     }
     // Secondary rays (incoherent): the same list for every tracer.
     if (secSamples > 0) {
@@ -590,7 +604,7 @@ int benchMesh(int argc, char** argv) {
     float fov = 45.0f;
     int threads = 0, packet = 256, repeat = 3, grid = 1, secondary = 4;
     bool wideVariants = false;
-    float singleNode = -1.0f, singleLeaf = -1.0f;
+    WideTuning tune;
     app.add_option("FILE", file, "Mesh file")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
     app.add_option("--at", at, "Camera target x,y,z");
@@ -612,11 +626,16 @@ int benchMesh(int argc, char** argv) {
         ->check(CLI::Range(1, 100));
     app.add_flag("--wide-variants", wideVariants,
                  "Also time wide BVH layouts (arity 8/16, leaf blocks of 4/8 triangles) on the secondary rays");
-    app.add_option("--single-lanes", singleNode,
+    app.add_option("--single-lanes", tune.singleNode,
                    "Wide packet traversal: nodes reached by at most this fraction of a chunk's lanes continue as "
                    "single rays (tuning; default: the library's)")
         ->check(CLI::Range(0.0f, 1.0f));
-    app.add_option("--single-lanes-leaf", singleLeaf, "The same for leaves (tuning)")->check(CLI::Range(0.0f, 1.0f));
+    app.add_option("--single-lanes-leaf", tune.singleLeaf, "The same for leaves (tuning)")
+        ->check(CLI::Range(0.0f, 1.0f));
+    app.add_option("--packet-split", tune.packetSplit,
+                   "Wide packet traversal: the whole packet splits nodes with at most this many candidate children "
+                   "before its chunks go on alone; 0: chunks start at the root (tuning; default: the library's)")
+        ->check(CLI::Range(0, 64));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -669,11 +688,9 @@ int benchMesh(int argc, char** argv) {
         setup.triNormal[i] = normalize(cross(b - a, c - a));
     }
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    if (packet == 16)
-        return run<16>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, singleNode, singleLeaf);
-    if (packet == 64)
-        return run<64>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, singleNode, singleLeaf);
-    return run<256>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, singleNode, singleLeaf);
+    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune);
+    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune);
+    return run<256>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune);
 }
 
 }  // namespace rtfact::bench

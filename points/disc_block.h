@@ -67,16 +67,9 @@ struct DiscBlockIntersector {
     template <int L>
     RTFACT_INLINE bool occludedBlocks(const DiscBlock<L>* blocks, int count, const RayPacket<1>& ray,
                                       Hit<1>& hit) const {
-        for (int k = 0; k < count; ++k) {
-            Packet<L> t;
-            const auto m = blockTest(blocks[k], ray, float(hit.t), t);
-            if (none(m)) continue;
-            const int lane = BitMask<L>(m).first();
-            hit.t = t[lane];
-            hit.id = blocks[k].id[lane];
-            return true;
-        }
-        return false;
+        return firstBlockHit<L>(blocks, count, hit, [&](const DiscBlock<L>& b, Packet<L>& t) {
+            return blockTest(b, ray, float(hit.t), t);
+        });
     }
 
    private:

@@ -237,17 +237,10 @@ struct TriangleIntersector {
     template <int L>
     RTFACT_INLINE bool occludedBlocks(const TriangleBlock<L>* blocks, int n, const RayPacket<1>& ray,
                                       Hit<1>& hit) const {
-        using P = Packet<L>;
-        for (int k = 0; k < n; ++k) {
-            P e0, e1, e2, t;
-            const auto m = blockTest(blocks[k], ray, float(hit.t), e0, e1, e2, t);
-            if (none(m)) continue;
-            const int lane = BitMask<L>(m).first();
-            hit.t = t[lane];
-            hit.id = blocks[k].id[lane];
-            return true;
-        }
-        return false;
+        return firstBlockHit<L>(blocks, n, hit, [&](const TriangleBlock<L>& b, Packet<L>& t) {
+            Packet<L> e0, e1, e2;
+            return blockTest(b, ray, float(hit.t), e0, e1, e2, t);
+        });
     }
 
    private:

@@ -18,6 +18,7 @@
 
 #include "core/accel/bvh.h"
 #include "core/ray/ray_packet.h"
+#include "core/simd/bitmask.h"
 #include "core/util/huge_pages.h"
 
 namespace rtfact {
@@ -257,6 +258,23 @@ inline void pushSorted(Entry* stack, int& sp, int base, const Entry& e) {
         --j;
     }
     stack[j] = e;
+}
+
+// Any hit among n leaf blocks (the blocks' occludedBlocks): the first hit lane of the
+// first block with one wins and goes into hit (t, id). test(block, t) returns the mask of
+// the block's lanes hit in (tMin, hit.t) and sets their distances t.
+template <int L, class Block, class H, class Test>
+RTFACT_INLINE bool firstBlockHit(const Block* blocks, int n, H& hit, Test&& test) {
+    for (int k = 0; k < n; ++k) {
+        Packet<L> t;
+        const auto m = test(blocks[k], t);
+        if (none(m)) continue;
+        const int lane = BitMask<L>(m).first();
+        hit.t = t[lane];
+        hit.id = blocks[k].id[lane];
+        return true;
+    }
+    return false;
 }
 
 }  // namespace rtfact

@@ -35,6 +35,61 @@ concept PacketBlockIntersector = BlockIntersector<I, Block> &&
     { isect.template intersectBlockLanes<HitData::Distance>(b, rays, hit, 0, 1u) } -> std::same_as<uint32_t>;
 };
 
+// An interval "frustum" of rays: origins in [orgLo, orgHi], reciprocal directions in
+// [invLo, invHi] of one sign per axis (uniform), distances in [tMinLo, tMaxHi].
+struct WideFrustum {
+    float orgLo[3], orgHi[3], invLo[3], invHi[3];
+    float tMinLo = 0.0f, tMaxHi = kInfinity;
+    int nearOff[3], farOff[3];  // near and far plane offsets into a node's bounds
+    bool uniform = true;
+
+    // org[a], inv[a]: the rays' origins and reciprocal directions on axis a.
+    template <int K, int W, class V>
+    void init(const V& org, const V& inv, const Packet<W>& tMin, const Mask<W>& active, bool commonOrigin) {
+        const Packet<W> inf(kInfinity);
+        uniform = true;
+        for (int a = 0; a < 3; ++a) {
+            invLo[a] = hmin(select(active, inv[a], inf));
+            invHi[a] = hmax(select(active, inv[a], -inf));
+            orgLo[a] = commonOrigin ? org[a][0] : hmin(select(active, org[a], inf));
+            orgHi[a] = commonOrigin ? org[a][0] : hmax(select(active, org[a], -inf));
+            uniform = uniform && (invLo[a] > 0.0f || invHi[a] < 0.0f);
+            // Bounds are lo[3][K] then hi[3][K].
+            nearOff[a] = (invHi[a] < 0.0f ? 3 * K : 0) + a * K;
+            farOff[a] = (invHi[a] < 0.0f ? 0 : 3 * K) + a * K;
+        }
+        tMinLo = hmin(select(active, tMin, inf));
+    }
+
+    // The children of a node (bounds f) some ray of the frustum may hit (empty slots
+    // never pass): one K-wide interval slab test; entry receives the entry distances.
+    template <bool CommonOrigin, int K>
+    RTFACT_INLINE uint64_t children(const float* f, Packet<K>& entry) const {
+        using PK = Packet<K>;
+        if (!uniform) {
+            entry = PK(tMinLo);
+            return BitMask<K>(PK::load(f) <= PK::load(f + 3 * K)).w[0];
+        }
+        entry = PK(tMinLo);
+        PK exit(tMaxHi);
+        for (int a = 0; a < 3; ++a) {
+            const PK iL(invLo[a]), iH(invHi[a]);
+            const PK nearP = PK::load(f + nearOff[a]), farP = PK::load(f + farOff[a]);
+            if constexpr (CommonOrigin) {
+                const PK dn = nearP - PK(orgLo[a]), df = farP - PK(orgLo[a]);
+                entry = max(entry, min(dn * iL, dn * iH));
+                exit = min(exit, max(df * iL, df * iH));
+            } else {
+                const PK dn0 = nearP - PK(orgLo[a]), dn1 = nearP - PK(orgHi[a]);
+                const PK df0 = farP - PK(orgLo[a]), df1 = farP - PK(orgHi[a]);
+                entry = max(entry, min(min(dn0 * iL, dn0 * iH), min(dn1 * iL, dn1 * iH)));
+                exit = min(exit, max(max(df0 * iL, df0 * iH), max(df1 * iL, df1 * iH)));
+            }
+        }
+        return BitMask<K>(entry <= exit).w[0];
+    }
+};
+
 template <class ElemIsect>
 struct WideBVHPacketIntersector {
     ElemIsect elem{};
@@ -44,6 +99,12 @@ struct WideBVHPacketIntersector {
     // The same for leaves: a block costs one ray about what one element costs a chunk, so
     // single rays win there up to most of the chunk's lanes.
     float singleRayLeafFraction = 0.75f;
+    // Packets of several chunks first go down the tree as a whole (one interval test of
+    // a node's children for all lanes) while at most this many children of a node are
+    // candidates; a node with more, or with a leaf among them, is where the packet's
+    // footprint outgrows the nodes: each chunk traverses it on its own. 0: chunks start
+    // at the root.
+    int packetSplit = 2;
     template <int N>
     using Hit = typename ElemIsect::template Hit<N>;
 
@@ -137,10 +198,63 @@ struct WideBVHPacketIntersector {
     // Lanes with hit.t > -inf are active.
     template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
     void traverseChunks(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit) const {
+        if constexpr (Packet<N>::C >= 2) {
+            if (packetSplit > 0 && !bvh.nodes.empty()) return traverseTop<CommonOrigin, D, AnyHit>(bvh, rays, hit);
+        }
+        chunksFrom<CommonOrigin, D, AnyHit>(bvh, rays, hit, 0);
+    }
+    // Every chunk with active lanes through the subtree of inner node `node`.
+    template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
+    void chunksFrom(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, int32_t node) const {
         const BitMask<N> bits(hit.t > Packet<N>(-kInfinity));
         for (int k = 0; k < Packet<N>::C; ++k)
             if (const uint32_t lanes = bits.chunkBits(k))
-                traverseChunk<CommonOrigin, D, AnyHit>(bvh, rays, hit, k, lanes);
+                traverseChunk<CommonOrigin, D, AnyHit>(bvh, rays, hit, k, lanes, node);
+    }
+
+    // The whole packet down the top of the tree (sign-uniform packets): nodes whose
+    // candidate children are few and inner are split at packet level, near to far; the
+    // others go to the chunks (chunksFrom), which then skip the levels above them.
+    template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
+    void traverseTop(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit) const {
+        constexpr int K = Tree::arity;
+        using P = Packet<N>;
+        const Mask<N> active = hit.t > P(-kInfinity);
+        WideFrustum fr;
+        fr.template init<K, N>(rays.org, rays.invDir, rays.tMin, active, CommonOrigin);
+        if (!fr.uniform) return chunksFrom<CommonOrigin, D, AnyHit>(bvh, rays, hit, 0);
+        fr.tMaxHi = hmax(hit.t);
+        struct Entry {
+            int32_t node;
+            float dist;
+        };
+        Entry stack[(K - 1) * 128 + 1];
+        int sp = 0;
+        stack[sp++] = {0, fr.tMinLo};
+        while (sp > 0) {
+            const Entry e = stack[--sp];
+            if (!(e.dist <= fr.tMaxHi)) continue;
+            const WideBVHNode<K>& n = bvh.nodes[size_t(e.node)];
+            Packet<K> entry;
+            uint64_t cand = fr.template children<CommonOrigin, K>(n.lo[0], entry);
+            bool split = __builtin_popcountll(cand) <= packetSplit;
+            for (uint64_t c = cand; c && split; c &= c - 1) split = n.count[__builtin_ctzll(c)] == 0;
+            if (!split) {
+                chunksFrom<CommonOrigin, D, AnyHit>(bvh, rays, hit, e.node);
+                if constexpr (AnyHit) {
+                    if (none(hit.t > P(-kInfinity))) return;
+                } else {
+                    fr.tMaxHi = hmax(hit.t);
+                }
+                continue;
+            }
+            RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the traversal stack");
+            const int base = sp;
+            for (; cand; cand &= cand - 1) {
+                const int c = __builtin_ctzll(cand);
+                pushSorted(stack, sp, base, Entry{n.child[c], entry[c]});  // the nearest ends on top
+            }
+        }
     }
 
     WideBVHIntersector<ElemIsect> single() const { return WideBVHIntersector<ElemIsect>{elem}; }
@@ -171,7 +285,8 @@ struct WideBVHPacketIntersector {
 
     // Chunk k (active lanes `lanes`) through the tree.
     template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
-    void traverseChunk(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, int k, uint32_t lanes) const {
+    void traverseChunk(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, int k, uint32_t lanes,
+                       int32_t start) const {
         if (bvh.nodes.empty()) return;
         constexpr int K = Tree::arity;
         constexpr int W = Packet<N>::W;
@@ -185,33 +300,26 @@ struct WideBVHPacketIntersector {
             singleRayLeafFraction > 0.0f ? std::max(1, int(singleRayLeafFraction * float(W))) : 0;
         if (singleRayFraction > 0.0f && __builtin_popcount(lanes) <= singleLanes) {
             for (uint32_t b = lanes; b; b &= b - 1)
-                singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), 0, 0);
+                singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), start, 0);
             return;
         }
         uint32_t open = lanes;  // lanes still searching (any hit: without an occluder)
         const Mask<W> chunkActive = hit.t.chunk(k) > P(-kInfinity);
 
         // The chunk's interval of origins and reciprocal directions (active lanes).
-        const P inf(kInfinity);
-        float orgLo[3], orgHi[3], invLo[3], invHi[3];
-        bool uniform = true;
-        int nearOff[3], farOff[3];
         P org[3], inv[3];
         for (int a = 0; a < 3; ++a) {
             inv[a] = rays.invDir[a].chunk(k);
             org[a] = CommonOrigin ? P(rays.org[a][0]) : rays.org[a].chunk(k);
-            invLo[a] = hmin(select(chunkActive, inv[a], inf));
-            invHi[a] = hmax(select(chunkActive, inv[a], -inf));
-            orgLo[a] = CommonOrigin ? rays.org[a][0] : hmin(select(chunkActive, org[a], inf));
-            orgHi[a] = CommonOrigin ? rays.org[a][0] : hmax(select(chunkActive, org[a], -inf));
-            uniform = uniform && (invLo[a] > 0.0f || invHi[a] < 0.0f);
-            // Near and far plane offsets into the node's bounds (lo[3][K] then hi[3][K]).
-            nearOff[a] = (invHi[a] < 0.0f ? 3 * K : 0) + a * K;
-            farOff[a] = (invHi[a] < 0.0f ? 0 : 3 * K) + a * K;
         }
         const P& tMin = rays.tMin.chunk(k);
-        const float tMinLo = hmin(select(chunkActive, tMin, inf));
-        float tMaxHi = hmax(hit.t.chunk(k));
+        WideFrustum fr;
+        fr.template init<K, W>(org, inv, tMin, chunkActive, CommonOrigin);
+        fr.tMaxHi = hmax(hit.t.chunk(k));
+        const bool uniform = fr.uniform;
+        const float* invHi = fr.invHi;
+        const float* orgLo = fr.orgLo;
+        const P inf(kInfinity);
 
         // Slab test of the chunk's lanes against child c of the node with bounds f, up to
         // each lane's current hit; tn receives the entry distances.
@@ -249,33 +357,14 @@ struct WideBVHPacketIntersector {
         };
         Entry stack[(K - 1) * 128 + 1];
         int sp = 0;
-        int32_t node = 0;
+        int32_t node = start;
         uint32_t nodeLanes = lanes;
         for (;;) {
             const WideBVHNode<K>& n = bvh.nodes[size_t(node)];
             const float* f = n.lo[0];
             // Children some lane of the chunk may hit (empty slots never pass).
-            uint64_t cand;
-            if (uniform) {
-                PK entry(tMinLo), exit(tMaxHi);
-                for (int a = 0; a < 3; ++a) {
-                    const PK iL(invLo[a]), iH(invHi[a]);
-                    const PK nearP = PK::load(f + nearOff[a]), farP = PK::load(f + farOff[a]);
-                    if constexpr (CommonOrigin) {
-                        const PK dn = nearP - PK(orgLo[a]), df = farP - PK(orgLo[a]);
-                        entry = max(entry, min(dn * iL, dn * iH));
-                        exit = min(exit, max(df * iL, df * iH));
-                    } else {
-                        const PK dn0 = nearP - PK(orgLo[a]), dn1 = nearP - PK(orgHi[a]);
-                        const PK df0 = farP - PK(orgLo[a]), df1 = farP - PK(orgHi[a]);
-                        entry = max(entry, min(min(dn0 * iL, dn0 * iH), min(dn1 * iL, dn1 * iH)));
-                        exit = min(exit, max(max(df0 * iL, df0 * iH), max(df1 * iL, df1 * iH)));
-                    }
-                }
-                cand = BitMask<K>(entry <= exit).w[0];
-            } else {
-                cand = BitMask<K>(PK::load(f) <= PK::load(f + 3 * K)).w[0];
-            }
+            PK entry;
+            uint64_t cand = fr.template children<CommonOrigin, K>(f, entry);
             // Each candidate against the chunk's lanes.
             const int base = sp;
             RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the traversal stack");
@@ -289,7 +378,9 @@ struct WideBVHPacketIntersector {
                 if constexpr (AnyHit) {
                     stack[sp++] = e;
                 } else {
-                    e.dist = hmin(select(m, tn, inf));
+                    // The interval entry bounds the lanes' entries from below: it orders the
+                    // children without a horizontal minimum per child.
+                    e.dist = uniform ? entry[c] : hmin(select(m, tn, inf));
                     pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                 }
             }
@@ -302,7 +393,7 @@ struct WideBVHPacketIntersector {
                     e.lanes &= open;
                     if (!e.lanes) continue;
                 } else {
-                    if (!(e.dist <= tMaxHi)) continue;
+                    if (!(e.dist <= fr.tMaxHi)) continue;
                     // Lanes that found a hit in front of the entry leave it.
                     P tn;
                     e.lanes &= uint32_t(BitMask<W>(laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn)).w[0]);
@@ -341,7 +432,7 @@ struct WideBVHPacketIntersector {
                     open &= ~uint32_t(BitMask<W>(found).w[0]);
                     if (!open) return;
                 }
-                tMaxHi = hmax(hit.t.chunk(k));
+                fr.tMaxHi = hmax(hit.t.chunk(k));
             }
         }
     }

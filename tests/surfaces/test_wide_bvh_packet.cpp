@@ -2,7 +2,8 @@
 // over all triangles: arity K = 4, 8, 16; packet sizes 1, native, 64 and 256; coherent
 // common-origin packets (camera-like, where the frustum culls), distinct origins
 // (parallel-ish rays and random ones), partial packets; nearest hit with barycentrics
-// and any hit; and the chunk path alone, the single-ray hand-over alone and both mixed.
+// and any hit; the chunk path alone, the single-ray hand-over alone and both mixed, each
+// with chunks starting at the root and below the whole packet's top-level traversal.
 // MeshScene routes primary and shadow rays through it and keeps the packet BVH's hits.
 #include <gtest/gtest.h>
 
@@ -88,9 +89,10 @@ RayPacket<N> makeRays(Rays kind, std::mt19937& rng, float spread) {
 }
 
 // singleRayFraction (nodes and leaves): 0 = chunks only, 1 = single rays only, in
-// between = mixed.
+// between = mixed. packetSplit: 0 = chunks start at the root, else the whole packet
+// splits nodes with up to that many candidate children first (64: every inner level).
 template <int K, int N>
-void checkPacketTraversal(Rays kind, float singleRayFraction) {
+void checkPacketTraversal(Rays kind, float singleRayFraction, int packetSplit) {
     if constexpr (!simd::ValidPacketSize<N>) {
         GTEST_SKIP() << "packet size " << N << " not supported by this build";
     } else {
@@ -98,7 +100,8 @@ void checkPacketTraversal(Rays kind, float singleRayFraction) {
         const auto tree = packetTree<K>(tris);
         WideBVHPacketIntersector<TriangleIntersector> isect;
         isect.singleRayFraction = isect.singleRayLeafFraction = singleRayFraction;
-        std::mt19937 rng(uint32_t(N * 7 + K * 3 + int(kind) + int(singleRayFraction * 8)));
+        isect.packetSplit = packetSplit;
+        std::mt19937 rng(uint32_t(N * 7 + K * 3 + int(kind) + int(singleRayFraction * 8) + packetSplit));
         std::uniform_real_distribution<float> u01(0.0f, 1.0f);
         const int packets = std::max(6, 1536 / N);
         int hits = 0, occChecked = 0, occluded = 0, edgeCases = 0;
@@ -163,10 +166,12 @@ void checkPacketTraversal(Rays kind, float singleRayFraction) {
 template <int K, int N>
 void checkAllModes() {
     for (Rays kind : {Rays::Camera, Rays::Parallel, Rays::Random})
-        for (float f : {0.0f, 0.3f, 1.0f}) {
-            SCOPED_TRACE(testing::Message() << "rays " << int(kind) << " singleRayFraction " << f);
-            checkPacketTraversal<K, N>(kind, f);
-        }
+        for (float f : {0.0f, 0.3f, 1.0f})
+            for (int split : {0, 2, 64}) {
+                SCOPED_TRACE(testing::Message()
+                             << "rays " << int(kind) << " singleRayFraction " << f << " packetSplit " << split);
+                checkPacketTraversal<K, N>(kind, f, split);
+            }
 }
 
 }  // namespace
