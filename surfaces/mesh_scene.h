@@ -118,7 +118,8 @@ struct MeshScene {
     // Coherent rays (primary, shadow, packet secondaries) take the binary packet BVH
     // when it is built (packetBVH, or no wide BVH), else the wide BVH's packet traversal
     // (WideBVHPacketIntersector). The binary BVH stays the default: on the dragon its
-    // primary rays measured 1.2-1.4x faster (shadow rays 0.7-0.9x; docs/benchmarks.md).
+    // primary rays measured 1.0-1.25x the wide packets' (shadow rays 0.7-0.9x; on the
+    // 1-2.5M-triangle grids the wide packets win 1.4-2.8x; docs/benchmarks.md).
     bool packetBVH = true;  // set before build()
     MeshWideBVH wide;
     Tracer<WideBVHIntersector<TriangleIntersector>> wideTracer;

@@ -121,3 +121,21 @@ def test_numpy_mesh_equals_cli_ply(tmp_path, cli):
     img = rtfact.render(rtfact.mesh(v.astype(np.float32), faces), size=SIZE)
     assert coverage(img) > 0.05
     assert_images_match(img, expected, "mesh", tmp_path)
+
+
+def test_volume_no_adaptive_steps_equals_cli(tmp_path, cli):
+    """no_adaptive_steps=True is the CLI's --no-adaptive-steps: the plain march."""
+    vol = blob_volume(np.uint8)
+    nz, ny, nx = vol.shape
+    raw = tmp_path / "blob.raw"
+    vol.tofile(raw)
+    out = tmp_path / "plain.exr"
+    cli("volume", raw, "--dims", f"{nx},{ny},{nz}", "--type", "u8", "-o", out, "--size", f"{SIZE[0]}x{SIZE[1]}",
+        "--tf", "viridis", "--no-adaptive-steps")
+    expected = rtfact.read_image(str(out))
+    scene = rtfact.volume(vol)
+    plain = rtfact.render(scene, size=SIZE, tf="viridis", no_adaptive_steps=True)
+    adaptive = rtfact.render(scene, size=SIZE, tf="viridis")
+    assert coverage(expected) > 0.05
+    assert_images_match(plain, expected, "volume_plain_march", tmp_path)
+    assert not np.array_equal(plain, adaptive), "the switch changed nothing: longer steps were expected"
