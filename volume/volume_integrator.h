@@ -172,19 +172,9 @@ struct VolumeIntegrator {
         const I cellHi[3] = {I(s.cells[0] - 1), I(s.cells[1] - 1), I(s.cells[2] - 1)};
         P skipAcc(0.0f);
         Packet<W, int32_t> sampleCount(0);
-        // DVR lanes leave `alive` one step after they become opaque: the sample positions
-        // (and so the gathers) of step k + 1 then do not wait for step k's compositing, and
-        // consecutive steps overlap. `open` masks the extra step out of the image and the counts.
-        const bool lagged = mode == VolumeMode::DVR || mode == VolumeMode::Shaded;
-        Mask<W> opaqueLag(false);
-        // A lane stays in a brick for several steps: its brick info is looked up again only
-        // when some lane changed brick (the lookup is on the chain from one step's position
-        // to the next).
-        I cidInfo(-1), info(0);
 
         while (any(alive)) {
             Vec3<W> p = clampToGrid<W>(s, oi + di * t);
-            const Mask<W> open = lagged ? alpha < term : Mask<W>(true);
             Mask<W> samp = alive;
             I start(0);
             bool haveStart = false;
@@ -203,10 +193,7 @@ struct VolumeIntegrator {
                 } else {
                     // one gather gives the brick, its step multiple, or (sign bit) the
                     // distance to the nearest brick that is not skipped
-                    if (any(cid != cidInfo)) {
-                        info = gather(s.brickInfo.data(), cid);
-                        cidInfo = cid;
-                    }
+                    const I info = gather(s.brickInfo.data(), cid);
                     empty = alive & (info < I(0));
                     start = (info & I(Scene::kPoolMask)) * I(Scene::kBrick);
                     haveStart = true;
@@ -225,14 +212,14 @@ struct VolumeIntegrator {
                     }
                     const P kk = max(-floor(-((tExit - tNear) * invDt - P(0.5f))), kf + P(1.0f));
                     const P tn = tNear + (kk + P(0.5f)) * dt;
-                    skipAcc += select(empty & open, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));
+                    skipAcc += select(empty, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));
                     kf = select(empty, kk, kf);
                     t = select(empty, tn, t);
                     samp = andNot(alive, empty);
                 }
             }
             if (any(samp)) {
-                sampleCount = sampleCount + select(samp & open, I(1), I(0));
+                sampleCount = sampleCount + select(samp, I(1), I(0));
                 // sampling lanes have not moved since the brick lookup; the others are masked
                 const P v = haveStart ? sample<W>(s, p, &start) : sample<W>(s, p);
                 if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
@@ -241,7 +228,7 @@ struct VolumeIntegrator {
                     P tb, ta;
                     const I pair = idx * I(2) + tfOffset;
                     fetchFloatPair<W>(s.rgbaSteps.data(), pair + I(1), tb, ta);
-                    const P a = select(samp & open, ta, P(0.0f));
+                    const P a = select(samp, ta, P(0.0f));
                     const Mask<W> contrib = a > P(0.0f);
                     if (any(contrib)) {
                         P tr, tg;
@@ -253,6 +240,7 @@ struct VolumeIntegrator {
                         alpha += w;
                         depth = select(contrib & (depth == P(kInfinity)), t, depth);
                     }
+                    alive = alive & (alpha < term);
                 } else if (mode == VolumeMode::MIP) {
                     maxv = select(samp, max(maxv, v), maxv);
                 } else {
@@ -287,8 +275,7 @@ struct VolumeIntegrator {
                 kf = select(samp, kf + mStep, kf);
                 t = select(samp, tNear + (kf + P(0.5f)) * dt, t);
             }
-            alive = andNot(alive & (t < tFar), opaqueLag);
-            if (lagged) opaqueLag = alpha >= term;
+            alive = alive & (t < tFar);
         }
         if (mode == VolumeMode::MIP) {
             const Mask<W> hit = maxv > P(-kInfinity);
