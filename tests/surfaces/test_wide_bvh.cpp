@@ -477,3 +477,24 @@ TEST(WideBVH, IntegratorsSameImageEitherStructure) {
     EXPECT_GT(wideW, 300u);  // at least the first bounce of every pixel on the mesh
     expectSameImage(ptImgP, ptImgW);
 }
+
+// Above packetBVHMaxTriangles the binary BVH is not built and coherent rays (camera and
+// shadow rays) take the wide BVH's packet traversal: the same picture.
+TEST(WideBVH, LargeMeshesTraceCoherentRaysThroughWidePackets) {
+    Mesh a = test::heightField(20, 4);
+    a.append(test::uvSphere({0.2f, 0.5f, -0.1f}, 0.35f, 12));
+    const auto m = std::make_shared<const Mesh>(a);
+    const MeshScene<BVH<Triangle>> small(m);  // far below the default threshold
+    EXPECT_FALSE(small.coherentWide());
+    EXPECT_FALSE(small.accel.nodes.empty());
+    MeshScene<BVH<Triangle>> large;
+    large.mesh = m;
+    large.packetBVHMaxTriangles = m->triangles() - 1;
+    large.build();
+    EXPECT_TRUE(large.coherentWide());
+    EXPECT_TRUE(large.accel.nodes.empty());  // no binary build
+    ASSERT_TRUE(large.hasWide());
+    AOIntegratorT<WideSecondaryRays> ao;  // camera rays plus occlusion rays
+    ao.samples = 4;
+    expectSameImage(renderWith(small, ao, 64, 48), renderWith(large, ao, 64, 48));
+}
