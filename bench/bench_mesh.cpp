@@ -430,7 +430,7 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     // rays use (its build, memory and packet traversal).
     MeshScene<BVH<Triangle>> scene, pscene;
     scene.mesh = pscene.mesh = meshPtr;
-    scene.packetBVH = false;
+    scene.packetBVHMaxTriangles = 0;  // the wide BVH alone
     pscene.buildWide = false;
     if (tune.singleNode >= 0.0f) scene.widePacketTracer.isect.singleRayFraction = tune.singleNode;
     if (tune.singleLeaf >= 0.0f) scene.widePacketTracer.isect.singleRayLeafFraction = tune.singleLeaf;

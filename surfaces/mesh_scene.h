@@ -117,12 +117,11 @@ struct MeshScene {
     bool buildWide = true;  // set before build()
     // Coherent rays (primary, shadow, packet secondaries) take the binary packet BVH
     // when it is built, else the wide BVH's packet traversal (WideBVHPacketIntersector).
-    // The binary one is built (packetBVH) for meshes of at most packetBVHMaxTriangles:
+    // The binary one is built for meshes of at most packetBVHMaxTriangles (0: never):
     // measured (quiet, AVX-512 and AVX2 builds, docs/benchmarks.md) its primary rays are
     // 1.2-1.3x the wide packets' on the 100k-triangle dragon, while from 278k triangles
     // on the wide packets win (primary 1.1-2.0x, shadow 1.5-2.5x) and skipping the binary
     // build saves 30-40% of the build time.
-    bool packetBVH = true;                   // set before build()
     size_t packetBVHMaxTriangles = 150'000;  // set before build()
     MeshWideBVH wide;
     Tracer<WideBVHIntersector<TriangleIntersector>> wideTracer;
@@ -149,7 +148,7 @@ struct MeshScene {
             accel = BVH<Triangle>{};
             wide = {};
             if (buildWide) wide = buildMeshWideBVH(m, std::span<const AABB>(bounds));
-            if (buildWide && !(packetBVH && n <= packetBVHMaxTriangles)) return finishBuild();
+            if (buildWide && n > packetBVHMaxTriangles) return finishBuild();
             meshBVHBuilder().build(std::span<const AABB>(bounds), static_cast<BVHTopology&>(accel));
             resizeHugePages(accel.elems, n);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {

@@ -5,13 +5,10 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <new>
 #include <string>
 
 #include "apps/rtfact/common_options.h"
 #include "apps/rtfact/outcome.h"
-#include "core/util/error.h"
-#include "engine/usage_error.h"
 
 namespace rtfact::app::mpi {
 
