@@ -5,7 +5,11 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <time.h>
+
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -40,19 +44,50 @@ inline std::string cpuModel() {
 
 inline constexpr int kTile = 32;
 
+// RTFACT_BENCH_CLOCK=cpu: one-thread figures are the calling thread's CPU time instead of
+// wall time. On a machine shared with other jobs the wall time of one thread swings by 2x
+// with the load (time slices), its CPU time far less; several threads keep wall time.
+inline bool cpuClockForOneThread() {
+    static const bool on = [] {
+        const char* e = std::getenv("RTFACT_BENCH_CLOCK");
+        const bool cpu = e != nullptr && std::string(e) == "cpu";
+        if (cpu) std::printf("clock: 1-thread figures are thread CPU time (RTFACT_BENCH_CLOCK=cpu)\n");
+        return cpu;
+    }();
+    return on;
+}
+inline double threadCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+// Runs body() in a task arena of `threads` threads; returns its time in ms (wall time, or
+// with one thread and RTFACT_BENCH_CLOCK=cpu the calling thread's CPU time: a one-thread
+// arena runs its work in the thread that calls execute).
+template <class F>
+double timeArena(int threads, F&& body) {
+    tbb::task_arena arena(threads);
+    if (threads == 1 && cpuClockForOneThread()) {
+        const double c0 = threadCpuMs();
+        arena.execute(body);
+        return threadCpuMs() - c0;
+    }
+    const auto t0 = Clock::now();
+    arena.execute(body);
+    return msSince(t0);
+}
+
 // Calls tile(x0, y0) for every kTile x kTile tile of a w x h image on `threads` threads;
-// returns the wall time in ms.
+// returns the time in ms (timeArena).
 template <class F>
 double timeTiles(int threads, int w, int h, F&& tile) {
     const int tx = (w + kTile - 1) / kTile, ty = (h + kTile - 1) / kTile;
-    tbb::task_arena arena(threads);
-    const auto t0 = Clock::now();
-    arena.execute([&] {
+    return timeArena(threads, [&] {
         tbb::parallel_for(tbb::blocked_range<int>(0, tx * ty, 1), [&](const tbb::blocked_range<int>& r) {
             for (int i = r.begin(); i != r.end(); ++i) tile((i % tx) * kTile, (i / tx) * kTile);
         });
     });
-    return msSince(t0);
 }
 
 }  // namespace rtfact::bench

@@ -157,13 +157,10 @@ SecondaryRays makeSecondary(const Frame& base, const Setup& s, const AABB& box, 
 
 template <class F>
 double timeRange(int threads, size_t n, size_t grain, F&& f) {
-    tbb::task_arena arena(threads);
-    const auto t0 = Clock::now();
-    arena.execute([&] {
+    return timeArena(threads, [&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain),
                           [&](const tbb::blocked_range<size_t>& r) { f(r.begin(), r.end()); });
     });
-    return msSince(t0);
 }
 
 // RTfact on the secondary ray list: packets of N through the packet BVH, or single rays
