@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <memory>
 #include <sstream>
 #include <thread>
@@ -258,6 +259,14 @@ void wideVariant(const Mesh& mesh, const SecondaryRays& sr, const std::vector<in
     }
 }
 
+// CPU time of the calling thread: with one thread the builds run on it alone, so this
+// figure holds on a loaded machine where wall time does not.
+double threadCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
 // ---- Embree -----------------------------------------------------------------------------
 
 struct EmbreeSide {
@@ -270,6 +279,7 @@ struct EmbreeSide {
         if (scene) rtcReleaseScene(scene);
         rtcReleaseDevice(device);
     }
+    double lastCpuMs = 0.0;  // the calling thread's CPU ms of the last build
     // Returns build ms (buffer copy excluded: both sides start from the loaded mesh).
     double build(const Mesh& m) {
         if (scene) rtcReleaseScene(scene);
@@ -293,7 +303,9 @@ struct EmbreeSide {
         rtcAttachGeometry(scene, g);
         rtcReleaseGeometry(g);
         const auto t0 = Clock::now();
+        const double c0 = threadCpuMs();
         rtcCommitScene(scene);
+        lastCpuMs = threadCpuMs() - c0;
         return msSince(t0);
     }
 
@@ -416,7 +428,7 @@ struct WideTuning {
 
 template <int N>
 int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, int h, int allThreads, int repeat,
-        int secSamples, bool wideVariants, const WideTuning& tune) {
+        int secSamples, bool wideVariants, const WideTuning& tune, bool buildOnly) {
     std::printf("cpu: %s, isa %s (Embree capped at %s)\n", cpuModel().c_str(), simd::isaName(), embreeMaxIsa());
     std::printf("file=%s\ntriangles=%zu\nimage=%dx%d\npacket=%d\nthreads_all=%d\n", file.c_str(), mesh.triangles(), w,
                 h, N, allThreads);
@@ -433,6 +445,7 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     if (tune.singleLeaf >= 0.0f) scene.widePacketTracer.isect.singleRayLeafFraction = tune.singleLeaf;
     if (tune.packetSplit >= 0) scene.widePacketTracer.isect.packetSplit = tune.packetSplit;
     double rtBuild[2] = {1e30, 1e30}, emBuild[2] = {1e30, 1e30}, packetBuild[2] = {1e30, 1e30};
+    double rtCpu = 1e30, emCpu = 1e30;  // 1-thread builds: CPU ms of the thread running them
     std::unique_ptr<EmbreeSide> em;
     for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
         const int T = threadCounts[ti];
@@ -440,16 +453,32 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
         for (int r = 0; r < repeat; ++r) {
             tbb::task_arena arena(T);
             const auto t0 = Clock::now();
+            const double c0 = threadCpuMs();
             arena.execute([&] { scene.build(); });
             rtBuild[ti] = std::min(rtBuild[ti], msSince(t0));
+            if (T == 1) rtCpu = std::min(rtCpu, threadCpuMs() - c0);
             arena.execute([&] { emBuild[ti] = std::min(emBuild[ti], em->build(mesh)); });
+            if (T == 1) emCpu = std::min(emCpu, em->lastCpuMs);
+            if (buildOnly) continue;
             const auto t1 = Clock::now();
             arena.execute([&] { pscene.build(); });
             packetBuild[ti] = std::min(packetBuild[ti], msSince(t1));
         }
-        std::printf("build_ms_threads%d: rtfact=%.2f rtfact_wide=%.2f embree=%.2f ratio=%.3f ratio_wide=%.3f\n", T,
-                    packetBuild[ti], rtBuild[ti], emBuild[ti], packetBuild[ti] / emBuild[ti],
-                    rtBuild[ti] / emBuild[ti]);
+        if (buildOnly)
+            std::printf("build_ms_threads%d: rtfact_wide=%.2f embree=%.2f ratio_wide=%.3f\n", T, rtBuild[ti],
+                        emBuild[ti], rtBuild[ti] / emBuild[ti]);
+        else
+            std::printf("build_ms_threads%d: rtfact=%.2f rtfact_wide=%.2f embree=%.2f ratio=%.3f ratio_wide=%.3f\n", T,
+                        packetBuild[ti], rtBuild[ti], emBuild[ti], packetBuild[ti] / emBuild[ti],
+                        rtBuild[ti] / emBuild[ti]);
+    }
+    std::printf("build_cpu_ms_threads1: rtfact_wide=%.2f embree=%.2f ratio_wide=%.3f\n", rtCpu, emCpu, rtCpu / emCpu);
+    if (buildOnly) {
+        // Only the wide BVH's build against Embree's (profiling the builder).
+        const size_t last = threadCounts.size() - 1;
+        std::printf("memory_bytes: rtfact_wide=%zu embree=%zu\nratio_build_wide=%.3f\n", scene.memoryBytes(),
+                    size_t(gEmbreeBytes.load()), rtBuild[last] / emBuild[last]);
+        return 0;
     }
     const double wideBytes = double(scene.memoryBytes()), rtBytes = double(pscene.memoryBytes()),
                  emBytes = double(gEmbreeBytes.load());
@@ -600,7 +629,7 @@ int benchMesh(int argc, char** argv) {
     std::string file, eye, at, up, size = "1024x1024";
     float fov = 45.0f;
     int threads = 0, packet = 256, repeat = 3, grid = 1, secondary = 4;
-    bool wideVariants = false;
+    bool wideVariants = false, buildOnly = false;
     WideTuning tune;
     app.add_option("FILE", file, "Mesh file")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
@@ -623,6 +652,8 @@ int benchMesh(int argc, char** argv) {
         ->check(CLI::Range(1, 100));
     app.add_flag("--wide-variants", wideVariants,
                  "Also time wide BVH layouts (arity 8/16, leaf blocks of 4/8 triangles) on the secondary rays");
+    app.add_flag("--build-only", buildOnly,
+                 "Only time the wide BVH's build against Embree's (no binary packet BVH, no rays): for profiling");
     app.add_option("--single-lanes", tune.singleNode,
                    "Wide packet traversal: nodes reached by at most this fraction of a chunk's lanes continue as "
                    "single rays (tuning; default: the library's)")
@@ -685,9 +716,9 @@ int benchMesh(int argc, char** argv) {
         setup.triNormal[i] = normalize(cross(b - a, c - a));
     }
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune);
-    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune);
-    return run<256>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune);
+    if (packet == 16) return run<16>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune, buildOnly);
+    if (packet == 64) return run<64>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune, buildOnly);
+    return run<256>(file, mesh, setup, w, h, all, repeat, secondary, wideVariants, tune, buildOnly);
 }
 
 }  // namespace rtfact::bench

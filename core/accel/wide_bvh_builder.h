@@ -7,14 +7,17 @@
 // cost of a leaf is no more than the split's. Works on bounds only, like every builder.
 //
 // Speed: references are 32 bytes (min and max in two SSE halves, the id in the spare
-// lane); small ranges use few bins (the bin clear and sweep would dominate); the top
-// levels bin and partition in parallel (private bins merged; out-of-place block
-// partition into a second buffer), and subtrees are built as parallel tasks.
+// lane); small ranges use few bins (the bin clear and sweep would dominate), large ones
+// alternate between two bin sets; the top levels bin and partition in parallel (private
+// bins merged; out-of-place block partition into a second buffer, which a one-thread
+// build neither needs nor allocates), and subtrees are built as parallel tasks. Scratch
+// nodes live on huge pages (page faults cost more than the binning on VMs).
 #pragma once
 #include <immintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -42,6 +45,7 @@ struct WideSAHBVHBuilder {
     static constexpr uint32_t kParallelSplit = 16384;  // parallel binning and partition above
     static constexpr uint32_t kParallelTasks = 1024;   // subtrees as tasks above
     static constexpr uint32_t kGrain = 4096;
+    static constexpr uint32_t kTwoBinSets = 256;  // ranges binned with two private bin sets
 
     template <int K>
     void build(std::span<const AABB> bounds, WideBVHTopology<K>& out) const;
@@ -71,17 +75,31 @@ struct WideSAHBVHBuilder {
         __m128 cmin, scale;
         int bins = 0;
     };
+    // Per axis and bin: bounds (lo, hi) and count. Only the first n bins are set up (small
+    // ranges use few bins: clearing all of them would cost more than binning).
     struct Bins {
-        Box4 box[3][kMaxBins];
+        __m128 lo[3][kMaxBins], hi[3][kMaxBins];
         uint32_t count[3][kMaxBins];
         int n;
         explicit Bins(int nb) : n(nb) {
-            for (int a = 0; a < 3; ++a) std::fill(count[a], count[a] + nb, 0u);
+            const __m128 inf = _mm_set1_ps(kInf), ninf = _mm_set1_ps(-kInf);
+            for (int a = 0; a < 3; ++a)
+                for (int k = 0; k < nb; ++k) {
+                    lo[a][k] = inf;
+                    hi[a][k] = ninf;
+                    count[a][k] = 0;
+                }
+        }
+        RTFACT_INLINE void add(int a, int k, __m128 l, __m128 h) {
+            lo[a][k] = _mm_min_ps(lo[a][k], l);
+            hi[a][k] = _mm_max_ps(hi[a][k], h);
+            count[a][k]++;
         }
         void merge(const Bins& o) {
             for (int a = 0; a < 3; ++a)
                 for (int k = 0; k < n; ++k) {
-                    box[a][k].extend(o.box[a][k]);
+                    lo[a][k] = _mm_min_ps(lo[a][k], o.lo[a][k]);
+                    hi[a][k] = _mm_max_ps(hi[a][k], o.hi[a][k]);
                     count[a][k] += o.count[a][k];
                 }
         }
@@ -89,7 +107,8 @@ struct WideSAHBVHBuilder {
     struct Ctx {
         Ref* buf[2];
         uint32_t* order;
-        void* nodes;  // WideBVHNode<K>*
+        void* nodes;             // WideBVHNode<K>*
+        uint32_t parallelSplit;  // ranges of this size on bin and partition in parallel
         std::atomic<uint32_t> next{0};
     };
 
@@ -102,21 +121,39 @@ struct WideSAHBVHBuilder {
         return _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, cmin), scale)), maxBin);
     }
 
+    // Bins refs [b, e). Large ranges alternate between bins and a second private set,
+    // merged at the end: consecutive references falling into the same bin then do not
+    // wait on each other's read-modify-write of that bin.
     static void binRange(const Ref* refs, uint32_t b, uint32_t e, const Split& s, Bins& bins) {
         const __m128i maxBin = _mm_set1_epi32(s.bins - 1);
-        alignas(16) int32_t k[4];
-        for (uint32_t i = b; i < e; ++i) {
-            const Ref& r = refs[i];
-            _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(r, s.cmin, s.scale, maxBin));
-            const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi);
-            for (int a = 0; a < 3; ++a) {
-                bins.count[a][k[a]]++;
-                bins.box[a][k[a]].extend(l, h);
+        alignas(16) int32_t k0[4], k1[4];
+        uint32_t i = b;
+        if (e - b >= kTwoBinSets) {
+            Bins other(s.bins);
+            for (; i + 1 < e; i += 2) {
+                const Ref& r0 = refs[i];
+                const Ref& r1 = refs[i + 1];
+                _mm_store_si128(reinterpret_cast<__m128i*>(k0), binOf(r0, s.cmin, s.scale, maxBin));
+                _mm_store_si128(reinterpret_cast<__m128i*>(k1), binOf(r1, s.cmin, s.scale, maxBin));
+                const __m128 l0 = _mm_load_ps(r0.lo), h0 = _mm_load_ps(r0.hi);
+                const __m128 l1 = _mm_load_ps(r1.lo), h1 = _mm_load_ps(r1.hi);
+                for (int a = 0; a < 3; ++a) {
+                    bins.add(a, k0[a], l0, h0);
+                    other.add(a, k1[a], l1, h1);
+                }
             }
+            bins.merge(other);
+        }
+        for (; i < e; ++i) {
+            const Ref& r = refs[i];
+            _mm_store_si128(reinterpret_cast<__m128i*>(k0), binOf(r, s.cmin, s.scale, maxBin));
+            const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi);
+            for (int a = 0; a < 3; ++a) bins.add(a, k0[a], l, h);
         }
     }
 
-    Split findSplit(const Range& r, const Ref* refs) const {
+    Split findSplit(const Ctx& ctx, const Range& r) const {
+        const Ref* refs = ctx.buf[r.buf];
         Split s;
         const uint32_t n = r.size();
         const AABB cb = r.cbox.aabb();
@@ -128,7 +165,7 @@ struct WideSAHBVHBuilder {
         s.scale = _mm_load_ps(sc);
         s.cmin = _mm_setr_ps(cb.lo.x, cb.lo.y, cb.lo.z, 0.0f);
         Bins bins(s.bins);
-        if (n >= kParallelSplit) {
+        if (n >= ctx.parallelSplit) {
             bins = tbb::parallel_reduce(
                 tbb::blocked_range<uint32_t>(r.b, r.e, kGrain), Bins(s.bins),
                 [&](const tbb::blocked_range<uint32_t>& br, Bins acc) {
@@ -149,14 +186,14 @@ struct WideSAHBVHBuilder {
             Box4 acc;
             uint32_t cnt = 0;
             for (int k = s.bins - 1; k > 0; --k) {
-                acc.extend(bins.box[a][k]);
+                acc.extend(bins.lo[a][k], bins.hi[a][k]);
                 cnt += bins.count[a][k];
                 rightCost[k] = cnt ? acc.halfArea() * blocks(cnt) : -1.0f;
             }
             acc = Box4{};
             cnt = 0;
             for (int k = 0; k < s.bins - 1; ++k) {
-                acc.extend(bins.box[a][k]);
+                acc.extend(bins.lo[a][k], bins.hi[a][k]);
                 cnt += bins.count[a][k];
                 if (cnt == 0 || rightCost[k + 1] < 0.0f) continue;
                 const float cost = acc.halfArea() * blocks(cnt) + rightCost[k + 1];
@@ -193,20 +230,24 @@ struct WideSAHBVHBuilder {
         const int a = s.axis, pos = s.pos, maxBin = s.bins - 1;
         const float sc = scl[a], cm = cmn[a];
         auto left = [=](const Ref& x) { return std::min(int((x.lo[a] + x.hi[a] - cm) * sc), maxBin) <= pos; };
-        if (n < kParallelSplit) {
+        if (n < ctx.parallelSplit) {
+            // Local accumulators: the swaps may alias l and rr for the compiler, which
+            // would then store them on every element.
+            Box4 lb, lc, rb, rc;
             uint32_t i = r.b, j = r.e;
             for (;;) {
                 while (i < j && left(src[i])) {
-                    extend(l.box, l.cbox, src[i]);
+                    extend(lb, lc, src[i]);
                     ++i;
                 }
                 while (i < j && !left(src[j - 1])) {
                     --j;
-                    extend(rr.box, rr.cbox, src[j]);
+                    extend(rb, rc, src[j]);
                 }
                 if (i >= j) break;
                 std::swap(src[i], src[j - 1]);
             }
+            l.box = lb, l.cbox = lc, rr.box = rb, rr.cbox = rc;
             l.b = r.b, l.e = i, rr.b = i, rr.e = r.e;
             l.buf = rr.buf = r.buf;
             return;
@@ -267,7 +308,7 @@ struct WideSAHBVHBuilder {
             return std::pair<int32_t, int32_t>(int32_t(r.b), int32_t(n));
         };
         if (n <= uint32_t(leafBlock) || depth >= kMaxDepth) return leaf();
-        Split s = findSplit(r, ctx.buf[r.buf]);
+        Split s = findSplit(ctx, r);
         const float area = r.box.halfArea();
         if (n <= uint32_t(maxLeafSize) && s.axis >= 0 &&
             intersectionCost * blocks(n) * area <= traversalCost * area + intersectionCost * s.cost)
@@ -288,7 +329,7 @@ struct WideSAHBVHBuilder {
             }
             if (best < 0) break;
             const Range c = kids[best];
-            const Split cs = findSplit(c, ctx.buf[c.buf]);
+            const Split cs = findSplit(ctx, c);
             partition(ctx, c, cs, kids[best], kids[cnt]);
             ++cnt;
         }
@@ -331,7 +372,9 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
     // the other), first touched by the threads that fill them.
     std::vector<Ref, UninitAllocator<Ref>> refs[2];
     resizeHugePages(refs[0], n);
-    resizeHugePages(refs[1], n);
+    // One thread: everything serial and in place (no second buffer to fault in).
+    const bool parallel = tbb::this_task_arena::max_concurrency() > 1;
+    if (parallel) resizeHugePages(refs[1], n);
     resizeHugePages(out.order, n);
     // References and the root's bounds, in parallel.
     struct Boxes {
@@ -356,12 +399,14 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
         });
     // At most n - 1 inner nodes (each has two or more children); untouched pages of
     // this upper bound cost nothing.
-    std::unique_ptr<WideBVHNode<K>[]> nodes(new WideBVHNode<K>[std::max<uint32_t>(n, 1)]);
+    std::vector<WideBVHNode<K>, UninitAllocator<WideBVHNode<K>>> nodes;
+    resizeHugePages(nodes, std::max<uint32_t>(n, 1));
     Ctx ctx;
     ctx.buf[0] = refs[0].data();
     ctx.buf[1] = refs[1].data();
+    ctx.parallelSplit = parallel ? kParallelSplit : std::numeric_limits<uint32_t>::max();
     ctx.order = out.order.data();
-    ctx.nodes = nodes.get();
+    ctx.nodes = nodes.data();
     Range r;
     r.b = 0, r.e = n, r.box = root.box, r.cbox = root.cbox;
     out.box = root.box.aabb();

@@ -128,6 +128,16 @@ struct WideBVHIntersector {
         for (size_t o = 0; o < sizeof(WideBVHNode<K>); o += 64) __builtin_prefetch(p + o);
     }
 
+    // The first block of a leaf that will be visited (block leaves are read whole, and
+    // the stack lets the load start before the leaf's turn).
+    template <class Tree>
+    static RTFACT_INLINE void prefetchLeaf(const Tree& bvh, int32_t first) {
+        if constexpr (requires { bvh.blocks; }) {
+            const char* p = reinterpret_cast<const char*>(bvh.blocks.data() + first);
+            for (size_t o = 0; o < sizeof(typename Tree::BlockType); o += 64) __builtin_prefetch(p + o);
+        }
+    }
+
     // Closest hit: children hit are visited near to far (a single hit child is entered
     // directly, more are insertion-sorted onto the stack) and a popped entry is skipped
     // once a closer hit is known. Any hit: no ordering at all, larger children first
@@ -187,7 +197,10 @@ struct WideBVHIntersector {
                     while (bits) {
                         const int c = 63 - __builtin_clzll(bits);
                         bits &= ~(uint64_t(1) << c);
-                        if (n.count[c] == 0) prefetchNode(nodes + n.child[c]);
+                        if (n.count[c] == 0)
+                            prefetchNode(nodes + n.child[c]);
+                        else
+                            prefetchLeaf(bvh, n.child[c]);
                         stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
                     }
                 } else {
@@ -195,7 +208,10 @@ struct WideBVHIntersector {
                     for (; bits; bits &= bits - 1) {
                         const int c = __builtin_ctzll(bits);
                         const Entry e{n.child[c], n.count[c], tn[c]};
-                        if (e.count == 0) prefetchNode(nodes + e.child);
+                        if (e.count == 0)
+                            prefetchNode(nodes + e.child);
+                        else
+                            prefetchLeaf(bvh, e.child);
                         pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                     }
                 }

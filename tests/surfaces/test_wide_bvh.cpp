@@ -5,6 +5,7 @@
 // and triangles, at packet sizes 1, native, 64 and 256, with common and distinct
 // origins and partial packets.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <atomic>
 #include <functional>
@@ -321,6 +322,34 @@ TEST(WideBVH, DirectStructureTriangles) {
 TEST(WideBVH, DirectStructureParallelTop) {
     const auto s = testSpheres(70000);
     checkDirectStructure<8>(s, 4);
+}
+// On one thread the builder partitions serially in place (no second reference buffer);
+// with more it partitions the top levels out of place in parallel. Both are valid trees
+// of the same shape: binning does not depend on the order within a range.
+TEST(WideBVH, DirectStructureOneThreadMatchesParallel) {
+    const auto s = testSpheres(70000);
+    tbb::task_arena one(1), two(2);
+    one.execute([&] { checkDirectStructure<8>(s, 4); });
+    const std::vector<AABB> bounds = boundsOf(s);
+    auto build = [&](tbb::task_arena& arena) {
+        WideBVHTopology<8> w;
+        arena.execute([&] { WideSAHBVHBuilder{}.build(std::span<const AABB>(bounds), w); });
+        return w;
+    };
+    const WideBVHTopology<8> a = build(one), b = build(two);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    auto stats = [](const WideBVHTopology<8>& w) {
+        double area = 0.0;
+        size_t leaves = 0;
+        for (const auto& n : w.nodes)
+            for (int i = 0; i < 8; ++i)
+                if (!n.isEmpty(i)) area += n.box(i).surfaceArea(), leaves += n.isLeaf(i);
+        return std::pair<double, size_t>(area, leaves);
+    };
+    const auto [areaA, leavesA] = stats(a);
+    const auto [areaB, leavesB] = stats(b);
+    EXPECT_EQ(leavesA, leavesB);
+    EXPECT_NEAR(areaA, areaB, 1e-9 * areaB);
 }
 // Coincident centroids (no SAH split exists): ranges are halved, leaves stay bounded.
 TEST(WideBVH, DirectStructureCoincident) {
