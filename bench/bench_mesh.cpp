@@ -19,7 +19,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <memory>
 #include <sstream>
 #include <thread>
@@ -257,14 +256,6 @@ void wideVariant(const Mesh& mesh, const SecondaryRays& sr, const std::vector<in
             "bounce_mrays=%.2f ratio_ao_vs_embree=%.3f ratio_bounce_vs_embree=%.3f\n",
             K, L, T, buildMs, w.memoryBytes(), aoM, bnM, aoM / embreeMrays[ti][1], bnM / embreeMrays[ti][0]);
     }
-}
-
-// CPU time of the calling thread: with one thread the builds run on it alone, so this
-// figure holds on a loaded machine where wall time does not.
-double threadCpuMs() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
 }
 
 // ---- Embree -----------------------------------------------------------------------------
