@@ -354,6 +354,15 @@ void checkMedianSplits(const std::vector<Disc>& input, int leafSize) {
         }
         const Range a = walk(n.left()), c = walk(n.left() + 1);
         EXPECT_EQ(a.count, (a.count + c.count) / 2) << "node " << node;
+        // The prefetch hints: the left child's summary follows this one's, the right's is named.
+        const KdNode& l = t.nodes[n.left()];
+        const KdNode& r = t.nodes[n.left() + 1];
+        if (!l.isLeaf()) {
+            EXPECT_EQ(LoDKdTree::innerIndex(l), LoDKdTree::innerIndex(n) + 1) << "node " << node;
+        }
+        if (!r.isLeaf()) {
+            EXPECT_EQ(t.inner[LoDKdTree::innerIndex(n)].rightInner, LoDKdTree::innerIndex(r)) << "node " << node;
+        }
         for (uint32_t i = a.first; i < a.first + a.count; ++i) EXPECT_LE(t.elems[i].center[n.axis()], n.split);
         for (uint32_t i = c.first; i < c.first + c.count; ++i) EXPECT_GE(t.elems[i].center[n.axis()], n.split);
         return {a.first, a.count + c.count};
