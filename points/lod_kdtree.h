@@ -21,6 +21,9 @@ namespace rtfact::points {
 struct LoDInner {
     Disc rep;
     uint8_t childBox[2][6];  // lo.xyz, hi.xyz per child, in 1/255 of the sphere box
+    // Inner index of the right child (the left child's is this one's + 1), so that the
+    // traversal can prefetch the far child's summary without waiting for its node.
+    uint32_t rightInner = 0;
 
     AABB box(int child) const {
         const float step = rep.radius * (2.0f / 255.0f);
@@ -30,7 +33,7 @@ struct LoDInner {
                 base + Vec3f(float(q[3]), float(q[4]), float(q[5])) * step};
     }
 };
-static_assert(sizeof(LoDInner) == 36);
+static_assert(sizeof(LoDInner) == 40);
 
 struct LoDKdTree : KdTree<Disc> {
     std::vector<LoDInner> inner;

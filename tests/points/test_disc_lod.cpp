@@ -8,8 +8,10 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <tuple>
 
 #include "core/render/pinhole_camera.h"
+#include "points/median_select.h"
 #include "points/point_prepare.h"
 #include "points/point_scene.h"
 
@@ -352,6 +354,15 @@ void checkMedianSplits(const std::vector<Disc>& input, int leafSize) {
         }
         const Range a = walk(n.left()), c = walk(n.left() + 1);
         EXPECT_EQ(a.count, (a.count + c.count) / 2) << "node " << node;
+        // The prefetch hints: the left child's summary follows this one's, the right's is named.
+        const KdNode& l = t.nodes[n.left()];
+        const KdNode& r = t.nodes[n.left() + 1];
+        if (!l.isLeaf()) {
+            EXPECT_EQ(LoDKdTree::innerIndex(l), LoDKdTree::innerIndex(n) + 1) << "node " << node;
+        }
+        if (!r.isLeaf()) {
+            EXPECT_EQ(t.inner[LoDKdTree::innerIndex(n)].rightInner, LoDKdTree::innerIndex(r)) << "node " << node;
+        }
         for (uint32_t i = a.first; i < a.first + a.count; ++i) EXPECT_LE(t.elems[i].center[n.axis()], n.split);
         for (uint32_t i = c.first; i < c.first + c.count; ++i) EXPECT_GE(t.elems[i].center[n.axis()], n.split);
         return {a.first, a.count + c.count};
@@ -364,7 +375,7 @@ void checkMedianSplits(const std::vector<Disc>& input, int leafSize) {
 }  // namespace
 
 TEST(LoDTree, SplitsAtTheMedianWithDistinctAndTiedCoordinates) {
-    // Above 65536 discs the builder's own selection runs, below it std::nth_element.
+    // Large and small ranges (the selection's sampled pivots, then std::nth_element).
     checkMedianSplits(randomDiscs(150000, 41), 8);
     checkMedianSplits(randomDiscs(777, 42), 1);
     // Coordinates on a coarse lattice: long runs of equal keys in every selection.
@@ -375,6 +386,35 @@ TEST(LoDTree, SplitsAtTheMedianWithDistinctAndTiedCoordinates) {
     std::vector<Disc> same = randomDiscs(500, 44);
     for (Disc& d : same) d.center = Vec3f(0.25f, 0.5f, 0.75f);
     checkMedianSplits(same, 4);
+}
+
+// The selection against std::nth_element: the k-th coordinate at k, nothing greater
+// before it, nothing smaller after it; the same multiset of discs; with distinct,
+// tied (few values) and all-equal coordinates, at every size class.
+TEST(LoDTree, SelectByCoordinateMatchesNthElement) {
+    std::mt19937 rng(45);
+    for (int n : {1, 2, 13, 25, 100, 1000, 5000, 70000})
+        for (int ties : {0, 3, 1}) {
+            std::vector<Disc> d = randomDiscs(n, uint32_t(n + ties));
+            if (ties > 0)
+                for (Disc& x : d) x.center.y = float(rng() % uint32_t(ties));
+            for (size_t k : {size_t(0), size_t(n / 2), size_t(n - 1)}) {
+                std::vector<Disc> a = d;
+                selectByCoordinate(a.data(), a.size(), k, 1);
+                std::vector<float> want(d.size());
+                for (size_t i = 0; i < d.size(); ++i) want[i] = d[i].center.y;
+                std::nth_element(want.begin(), want.begin() + long(k), want.end());
+                ASSERT_EQ(a[k].center.y, want[k]) << n << " " << ties << " " << k;
+                for (size_t i = 0; i < k; ++i) ASSERT_LE(a[i].center.y, a[k].center.y);
+                for (size_t i = k + 1; i < a.size(); ++i) ASSERT_GE(a[i].center.y, a[k].center.y);
+                auto key = [](const Disc& x) { return std::tuple(x.center.x, x.center.y, x.center.z, x.rgba); };
+                std::vector<std::tuple<float, float, float, uint32_t>> ka, kd;
+                for (size_t i = 0; i < a.size(); ++i) ka.push_back(key(a[i])), kd.push_back(key(d[i]));
+                std::sort(ka.begin(), ka.end());
+                std::sort(kd.begin(), kd.end());
+                ASSERT_EQ(ka, kd);
+            }
+        }
 }
 
 namespace {
