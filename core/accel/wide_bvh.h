@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <concepts>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <utility>
 #include <vector>
@@ -219,8 +218,9 @@ BlockedWideBVH<Block, K> packLeafBlocks(WideBVHTopology<K>&& t, const Fill& fill
     const size_t n = out.order.size(), nn = out.nodes.size();
     if (n == 0) return out;
     // First block of each leaf, by the leaf's first element (leaves tile [0, n)); only
-    // leaf starts are written and read.
-    std::unique_ptr<uint32_t[]> first(new uint32_t[n]);
+    // leaf starts are written and read. On huge pages: every 4 KiB page of it is touched.
+    std::vector<uint32_t> first;
+    resizeHugePages(first, n);
     auto* nodes = out.nodes.data();
     tbb::parallel_for(size_t(0), nn, [&](size_t ni) {
         for (int i = 0; i < K; ++i)
