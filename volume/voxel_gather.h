@@ -6,6 +6,7 @@
 // loads for narrower or scalar packets. Packets of several native chunks are fetched
 // chunk by chunk.
 #pragma once
+#include <cstdint>
 #include <cstring>
 #include <type_traits>
 
@@ -107,6 +108,85 @@ RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packe
     }
 }
 
+// The four corners of a cell face from the y-pair layout (BrickedVolume::pairs): entry
+// idx holds (x, y), (x, y + 1), entry idx + 1 (x + 1, y), (x + 1, y + 1); one 32-bit (u8)
+// or 64-bit (u16) gather per lane fetches both entries. a0 = (x, y), a1 = (x, y + 1),
+// b0 = (x + 1, y), b1 = (x + 1, y + 1).
+template <class T, int W>
+RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packet<W>& a0, Packet<W>& a1, Packet<W>& b0,
+                             Packet<W>& b1) {
+    static_assert(sizeof(T) < 4, "y-pairs are u8 or u16");
+    using namespace simd;
+    if constexpr (Packet<W>::C > 1) {
+        for (int k = 0; k < Packet<W>::C; ++k)
+            fetchQuad<T, Packet<W>::W>(base, idx.chunk(k), a0.chunk(k), a1.chunk(k), b0.chunk(k), b1.chunk(k));
+        return;
+    }
+#if RTFACT_NATIVE_WIDTH == 8
+    if constexpr (W == 8) {
+        if constexpr (sizeof(T) == 1) {
+            const __m256i g = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 2);
+            const __m256i m = _mm256_set1_epi32(0xFF);
+            a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, m));
+            a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(g, 8), m));
+            b0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(g, 16), m));
+            b1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(g, 24));
+        } else {
+            const __m256 lo =
+                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, lowHalf8(idx.c[0]), 4));
+            const __m256 hi =
+                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, highHalf8(idx.c[0]), 4));
+            nvec<float, 8> pa, pb;  // (a0 | a1 << 16) and (b0 | b1 << 16) per lane
+            splitPairs8(lo, hi, pa, pb);
+            const __m256i ia = _mm256_castps_si256((__m256)pa), ib = _mm256_castps_si256((__m256)pb);
+            const __m256i m = _mm256_set1_epi32(0xFFFF);
+            a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(ia, m));
+            a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(ia, 16));
+            b0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(ib, m));
+            b1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(ib, 16));
+        }
+        return;
+    }
+#endif
+#if RTFACT_NATIVE_WIDTH >= 16
+    if constexpr (W == 16) {
+        if constexpr (sizeof(T) == 1) {
+            const __m512i g =
+                _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), kAll16, (__m512i)idx.c[0], (const void*)base, 2);
+            const __m512i m = _mm512_set1_epi32(0xFF);
+            a0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(g, m));
+            a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(
+                kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 8), m));
+            b0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(
+                kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 16), m));
+            b1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_srli_epi32(kAll16, g, 24));
+        } else {
+            const __m512i lo =
+                _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 4);
+            const __m512i hi =
+                _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx.c[0]), (const void*)base, 4);
+            const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+            const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+            const __m512i ia = _mm512_permutex2var_epi32(lo, even, hi);  // a0 | a1 << 16
+            const __m512i ib = _mm512_permutex2var_epi32(lo, odd, hi);   // b0 | b1 << 16
+            const __m512i m = _mm512_set1_epi32(0xFFFF);
+            a0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(ia, m));
+            a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_srli_epi32(kAll16, ia, 16));
+            b0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(ib, m));
+            b1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_srli_epi32(kAll16, ib, 16));
+        }
+        return;
+    }
+#endif
+    for (int i = 0; i < W; ++i) {
+        const T* p = base + 2 * size_t(uint32_t(idx[i]));
+        a0[i] = float(p[0]);
+        a1[i] = float(p[1]);
+        b0[i] = float(p[2]);
+        b1[i] = float(p[3]);
+    }
+}
+
 // Two adjacent floats per lane from base[2 * idx] (for interleaved tables): 64-bit
 // gathers on AVX-512 (half the gathered elements of two 32-bit gathers).
 template <int W>
@@ -140,6 +220,108 @@ RTFACT_INLINE void fetchFloatPair(const float* base, const Packet<W, int32_t>& i
     for (int i = 0; i < W; ++i) {
         a[i] = base[2 * idx2[i]];
         b[i] = base[2 * idx2[i] + 1];
+    }
+}
+
+// IEEE binary16 <-> float, round to nearest even (for the half-float TF table; the gather
+// paths convert with F16C / AVX-512, these are the scalar path and the table builder).
+inline uint16_t floatToHalf(float f) {
+    uint32_t x;
+    std::memcpy(&x, &f, 4);
+    const uint32_t sign = (x >> 16) & 0x8000u;
+    x &= 0x7fffffffu;
+    if (x >= 0x7f800000u) return uint16_t(sign | 0x7c00u | (x > 0x7f800000u ? 0x200u : 0u));  // inf, nan
+    if (x >= 0x477ff000u) return uint16_t(sign | 0x7c00u);                                    // overflow
+    if (x < 0x38800000u) {  // subnormal half (or zero)
+        if (x < 0x33000000u) return uint16_t(sign);
+        const uint32_t e = x >> 23, m = (x & 0x7fffffu) | 0x800000u;
+        const uint32_t shift = 126u - e;  // value m * 2^(e - 150) in units of 2^-24
+        uint32_t h = m >> shift;
+        const uint32_t rest = m & ((1u << shift) - 1u), half = 1u << (shift - 1u);
+        if (rest > half || (rest == half && (h & 1u))) ++h;
+        return uint16_t(sign | h);
+    }
+    uint32_t h = ((x - 0x38000000u) >> 13);
+    const uint32_t rest = x & 0x1fffu;
+    if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;
+    return uint16_t(sign | h);
+}
+inline float halfToFloat(uint16_t h) {
+    const uint32_t sign = uint32_t(h & 0x8000u) << 16, e = (h >> 10) & 0x1fu, m = h & 0x3ffu;
+    uint32_t x;
+    if (e == 0) {
+        if (m == 0) {
+            x = sign;
+        } else {  // subnormal: m * 2^-24
+            const float f = float(m) * (1.0f / 16777216.0f);
+            std::memcpy(&x, &f, 4);
+            x |= sign;
+        }
+    } else if (e == 31) {
+        x = sign | 0x7f800000u | (m << 13);
+    } else {
+        x = sign | ((e + 112u) << 23) | (m << 13);
+    }
+    float f;
+    std::memcpy(&f, &x, 4);
+    return f;
+}
+
+// r, g, b, a of table entry idx from a table of 4 halves per entry: one 64-bit gather
+// per lane (two 64-bit pair gathers for a float table), converted with F16C / AVX-512.
+template <int W>
+RTFACT_INLINE void fetchHalfRGBA(const uint16_t* base, const Packet<W, int32_t>& idx, Packet<W>& r, Packet<W>& g,
+                                 Packet<W>& b, Packet<W>& a) {
+    using namespace simd;
+    if constexpr (Packet<W>::C > 1) {
+        for (int k = 0; k < Packet<W>::C; ++k)
+            fetchHalfRGBA<Packet<W>::W>(base, idx.chunk(k), r.chunk(k), g.chunk(k), b.chunk(k), a.chunk(k));
+        return;
+    }
+#if RTFACT_NATIVE_WIDTH == 8
+    if constexpr (W == 8) {
+        const __m256i lo = _mm256_i32gather_epi64((const long long*)base, lowHalf8(idx.c[0]), 8);
+        const __m256i hi = _mm256_i32gather_epi64((const long long*)base, highHalf8(idx.c[0]), 8);
+        // per 128-bit lane (two entries r0 g0 b0 a0 r1 g1 b1 a1) -> r0 r1 g0 g1 b0 b1 a0 a1
+        const __m256i words = _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, 8, 9, 2, 3,
+                                               10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
+        const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+        // dwords: r01 r23 g01 g23 b01 b23 a01 a23 (lanes 0-3 from lo, 4-7 from hi)
+        const __m256i l = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(lo, words), order);
+        const __m256i h = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hi, words), order);
+        const __m256i rb = _mm256_unpacklo_epi64(l, h), ga = _mm256_unpackhi_epi64(l, h);
+        r.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_castsi256_si128(rb));
+        b.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_extracti128_si256(rb, 1));
+        g.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_castsi256_si128(ga));
+        a.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_extracti128_si256(ga, 1));
+        return;
+    }
+#endif
+#if RTFACT_NATIVE_WIDTH >= 16
+    if constexpr (W == 16) {
+        const __m512i lo =
+            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 8);
+        const __m512i hi =
+            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx.c[0]), (const void*)base, 8);
+        // word j of [r | g] (or [b | a]): component j / 16 (+ 2) of lane j % 16 (lanes 8-15 in hi)
+        alignas(64) static constexpr int16_t kRG[32] = {0, 4, 8, 12, 16, 20, 24, 28, 32, 36, 40, 44, 48, 52, 56, 60,
+                                                        1, 5, 9, 13, 17, 21, 25, 29, 33, 37, 41, 45, 49, 53, 57, 61};
+        const __m512i rgIdx = _mm512_load_si512((const void*)kRG);
+        const __m512i rg = _mm512_permutex2var_epi16(lo, rgIdx, hi);
+        const __m512i ba = _mm512_permutex2var_epi16(lo, _mm512_add_epi16(rgIdx, _mm512_set1_epi16(2)), hi);
+        r.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_castsi512_si256(rg));
+        g.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_extracti64x4_epi64(rg, 1));
+        b.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_castsi512_si256(ba));
+        a.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_extracti64x4_epi64(ba, 1));
+        return;
+    }
+#endif
+    for (int i = 0; i < W; ++i) {
+        const uint16_t* e = base + 4 * size_t(uint32_t(idx[i]));
+        r[i] = halfToFloat(e[0]);
+        g[i] = halfToFloat(e[1]);
+        b[i] = halfToFloat(e[2]);
+        a[i] = halfToFloat(e[3]);
     }
 }
 
