@@ -94,6 +94,11 @@ bool buildPairs(BrickedVolume& v) {
     // Entries are addressed with 32-bit indices, like the pool's samples.
     if (uint64_t(bricks) * uint64_t(BrickedVolume::kPairEntries) > uint64_t(std::numeric_limits<int32_t>::max()) - 64)
         return false;
+    // Only while the copy stays cache-sized: measured (session s6, both ISAs) faster on the
+    // head CT (2 MB of pairs) but slower on the bonsai (42 MB) and the 512^3 phantom
+    // (183 MB), where the march waits on cache misses and the larger copy adds to them.
+    constexpr uint64_t kMaxPairBytes = uint64_t(16) << 20;
+    if (need > kMaxPairBytes) return false;
     // Optional: keep a quarter of what is available for everything else (frame buffers, a
     // second scene), else render from the pool alone.
     if (need > availableMemoryBytes() / 4 * 3) return false;
