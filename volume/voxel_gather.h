@@ -6,7 +6,6 @@
 // loads for narrower or scalar packets. Packets of several native chunks are fetched
 // chunk by chunk.
 #pragma once
-#include <cstdint>
 #include <cstring>
 #include <type_traits>
 
@@ -220,108 +219,6 @@ RTFACT_INLINE void fetchFloatPair(const float* base, const Packet<W, int32_t>& i
     for (int i = 0; i < W; ++i) {
         a[i] = base[2 * idx2[i]];
         b[i] = base[2 * idx2[i] + 1];
-    }
-}
-
-// IEEE binary16 <-> float, round to nearest even (for the half-float TF table; the gather
-// paths convert with F16C / AVX-512, these are the scalar path and the table builder).
-inline uint16_t floatToHalf(float f) {
-    uint32_t x;
-    std::memcpy(&x, &f, 4);
-    const uint32_t sign = (x >> 16) & 0x8000u;
-    x &= 0x7fffffffu;
-    if (x >= 0x7f800000u) return uint16_t(sign | 0x7c00u | (x > 0x7f800000u ? 0x200u : 0u));  // inf, nan
-    if (x >= 0x477ff000u) return uint16_t(sign | 0x7c00u);                                    // overflow
-    if (x < 0x38800000u) {  // subnormal half (or zero)
-        if (x < 0x33000000u) return uint16_t(sign);
-        const uint32_t e = x >> 23, m = (x & 0x7fffffu) | 0x800000u;
-        const uint32_t shift = 126u - e;  // value m * 2^(e - 150) in units of 2^-24
-        uint32_t h = m >> shift;
-        const uint32_t rest = m & ((1u << shift) - 1u), half = 1u << (shift - 1u);
-        if (rest > half || (rest == half && (h & 1u))) ++h;
-        return uint16_t(sign | h);
-    }
-    uint32_t h = ((x - 0x38000000u) >> 13);
-    const uint32_t rest = x & 0x1fffu;
-    if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;
-    return uint16_t(sign | h);
-}
-inline float halfToFloat(uint16_t h) {
-    const uint32_t sign = uint32_t(h & 0x8000u) << 16, e = (h >> 10) & 0x1fu, m = h & 0x3ffu;
-    uint32_t x;
-    if (e == 0) {
-        if (m == 0) {
-            x = sign;
-        } else {  // subnormal: m * 2^-24
-            const float f = float(m) * (1.0f / 16777216.0f);
-            std::memcpy(&x, &f, 4);
-            x |= sign;
-        }
-    } else if (e == 31) {
-        x = sign | 0x7f800000u | (m << 13);
-    } else {
-        x = sign | ((e + 112u) << 23) | (m << 13);
-    }
-    float f;
-    std::memcpy(&f, &x, 4);
-    return f;
-}
-
-// r, g, b, a of table entry idx from a table of 4 halves per entry: one 64-bit gather
-// per lane (two 64-bit pair gathers for a float table), converted with F16C / AVX-512.
-template <int W>
-RTFACT_INLINE void fetchHalfRGBA(const uint16_t* base, const Packet<W, int32_t>& idx, Packet<W>& r, Packet<W>& g,
-                                 Packet<W>& b, Packet<W>& a) {
-    using namespace simd;
-    if constexpr (Packet<W>::C > 1) {
-        for (int k = 0; k < Packet<W>::C; ++k)
-            fetchHalfRGBA<Packet<W>::W>(base, idx.chunk(k), r.chunk(k), g.chunk(k), b.chunk(k), a.chunk(k));
-        return;
-    }
-#if RTFACT_NATIVE_WIDTH == 8
-    if constexpr (W == 8) {
-        const __m256i lo = _mm256_i32gather_epi64((const long long*)base, lowHalf8(idx.c[0]), 8);
-        const __m256i hi = _mm256_i32gather_epi64((const long long*)base, highHalf8(idx.c[0]), 8);
-        // per 128-bit lane (two entries r0 g0 b0 a0 r1 g1 b1 a1) -> r0 r1 g0 g1 b0 b1 a0 a1
-        const __m256i words = _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, 8, 9, 2, 3,
-                                               10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
-        const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-        // dwords: r01 r23 g01 g23 b01 b23 a01 a23 (lanes 0-3 from lo, 4-7 from hi)
-        const __m256i l = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(lo, words), order);
-        const __m256i h = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hi, words), order);
-        const __m256i rb = _mm256_unpacklo_epi64(l, h), ga = _mm256_unpackhi_epi64(l, h);
-        r.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_castsi256_si128(rb));
-        b.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_extracti128_si256(rb, 1));
-        g.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_castsi256_si128(ga));
-        a.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_extracti128_si256(ga, 1));
-        return;
-    }
-#endif
-#if RTFACT_NATIVE_WIDTH >= 16
-    if constexpr (W == 16) {
-        const __m512i lo =
-            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 8);
-        const __m512i hi =
-            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx.c[0]), (const void*)base, 8);
-        // word j of [r | g] (or [b | a]): component j / 16 (+ 2) of lane j % 16 (lanes 8-15 in hi)
-        alignas(64) static constexpr int16_t kRG[32] = {0, 4, 8, 12, 16, 20, 24, 28, 32, 36, 40, 44, 48, 52, 56, 60,
-                                                        1, 5, 9, 13, 17, 21, 25, 29, 33, 37, 41, 45, 49, 53, 57, 61};
-        const __m512i rgIdx = _mm512_load_si512((const void*)kRG);
-        const __m512i rg = _mm512_permutex2var_epi16(lo, rgIdx, hi);
-        const __m512i ba = _mm512_permutex2var_epi16(lo, _mm512_add_epi16(rgIdx, _mm512_set1_epi16(2)), hi);
-        r.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_castsi512_si256(rg));
-        g.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_extracti64x4_epi64(rg, 1));
-        b.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_castsi512_si256(ba));
-        a.c[0] = (nvec<float, 16>)_mm512_cvtph_ps(_mm512_extracti64x4_epi64(ba, 1));
-        return;
-    }
-#endif
-    for (int i = 0; i < W; ++i) {
-        const uint16_t* e = base + 4 * size_t(uint32_t(idx[i]));
-        r[i] = halfToFloat(e[0]);
-        g[i] = halfToFloat(e[1]);
-        b[i] = halfToFloat(e[2]);
-        a[i] = halfToFloat(e[3]);
     }
 }
 
