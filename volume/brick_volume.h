@@ -32,6 +32,13 @@ struct BrickedVolume {
     std::vector<uint8_t> pool;          // bricks of kBrick samples; brick 0 is all zero
     std::vector<int32_t> brickStart;    // per brick: first sample in the pool
     std::vector<float> cellLo, cellHi;  // per brick: stored min/max
+    // u8/u16 only, a second copy of the pool for the march: y-pair rows. Pool brick b is
+    // pair brick b of kPairEntries entries; entry (x, y, z), y < kCells, holds the samples
+    // (x, y, z) and (x, y + 1, z), so one 32-bit (u8) or 64-bit (u16) load at (x, y, z)
+    // returns the four corners of a cell face: a trilinear sample is 2 gathers, not 4.
+    // Empty when the memory budget did not allow it (the march then reads the pool).
+    static constexpr int kPairRow = kEdge, kPairSlice = kEdge * kCells, kPairEntries = kPairSlice * kEdge;
+    std::vector<uint8_t> pairs;
 
     size_t brickCount() const { return size_t(nb[0]) * size_t(nb[1]) * size_t(nb[2]); }
     size_t brickIndex(int bx, int by, int bz) const {
@@ -41,7 +48,8 @@ struct BrickedVolume {
     // non-empty bricks (brick 0, the shared zero brick, not counted)
     size_t storedBricks() const { return pool.size() / (size_t(kBrick) * size_t(storageBytes(storage))) - 1; }
     size_t memoryBytes() const {
-        return pool.capacity() + brickStart.capacity() * 4 + (cellLo.capacity() + cellHi.capacity()) * 4;
+        return pool.capacity() + pairs.capacity() + brickStart.capacity() * 4 +
+               (cellLo.capacity() + cellHi.capacity()) * 4;
     }
     template <class T>
     const T* data() const {
@@ -70,8 +78,13 @@ struct BrickBuilder {
     // Appends a brick filled by fill(i, j, k) -> stored value for local samples.
     template <class F>
     static void addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill);
+    // Checks the offsets, pads the pool and builds the y-pair copy (buildPairs).
     static void finish(BrickedVolume& v);
 };
+
+// Builds v.pairs from v.pool for u8/u16 volumes when the memory budget allows it
+// (1.78x the pool; core/util/memory_budget.h), else leaves it empty. Returns whether built.
+bool buildPairs(BrickedVolume& v);
 
 template <class F>
 void BrickBuilder::addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill) {

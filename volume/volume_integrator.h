@@ -17,6 +17,14 @@ struct VolumeIntegrator {
 
     template <int N, class Scene>
     Radiance<N> eval(const Scene& s, RayPacket<N>& rays, const Mask<N>& active, const PixelSample<N>&) const {
+        // The voxel layout, once per packet: y-pairs when the volume has them.
+        if constexpr (sizeof(typename Scene::Voxel) < 4)
+            if (s.pairVoxels) return evalIn<VoxelLayout::YPairs, N>(s, rays, active);
+        return evalIn<VoxelLayout::Rows, N>(s, rays, active);
+    }
+
+    template <VoxelLayout L, int N, class Scene>
+    Radiance<N> evalIn(const Scene& s, RayPacket<N>& rays, const Mask<N>& active) const {
         tlsCounters.rays += uint64_t(popcount(active));
         Radiance<N> r;
         uint64_t samples = 0;
@@ -27,8 +35,8 @@ struct VolumeIntegrator {
         for (int k = 0; k < C; k += G) {
             Vec3<G * W> col;
             Packet<G * W> alpha, depth;
-            march<G * W>(s, group<G * W>(rays.org, k), group<G * W>(rays.dir, k), group<G * W>(rays.tMin, k),
-                         group<G * W>(rays.tMax, k), group<G * W>(active, k), col, alpha, depth, samples, skipped);
+            march<G * W, L>(s, group<G * W>(rays.org, k), group<G * W>(rays.dir, k), group<G * W>(rays.tMin, k),
+                            group<G * W>(rays.tMax, k), group<G * W>(active, k), col, alpha, depth, samples, skipped);
             for (int j = 0; j < G; ++j) {
                 r.color.setChunk(k + j, col.chunk(j));
                 r.alpha.chunk(k + j) = alpha.chunk(j);
@@ -60,26 +68,33 @@ struct VolumeIntegrator {
         return r;
     }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
-    // `knownStart`: the brick's first sample when the caller already looked it up.
-    template <int W, class Scene>
+    // `knownStart`: the brick's first entry (in layout L) when the caller looked it up.
+    template <int W, VoxelLayout L = VoxelLayout::Rows, class Scene>
     static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p,
                                           const Packet<W, int32_t>* knownStart = nullptr) {
         const bool haveStart = knownStart != nullptr;
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
-        constexpr int E = Scene::kEdge;
+        constexpr int R = Scene::template kRowStride<L>, S = Scene::template kSliceStride<L>;
         const I ix = toInt(p.x), iy = toInt(p.y), iz = toInt(p.z);
         const P fx = p.x - toFloat(ix), fy = p.y - toFloat(iy), fz = p.z - toFloat(iz);
-        // brick of the cell, then the cell's first sample inside the brick
+        // brick of the cell, then the cell's first entry inside the brick
         static_assert(Scene::kCells == 8);
         const I bx = shiftRight<W>(ix, 3), by = shiftRight<W>(iy, 3), bz = shiftRight<W>(iz, 3);
-        const I start = haveStart ? *knownStart : gather(s.brickStart, bx + by * I(s.nbx) + bz * I(s.nbxy));
-        const I base = start + (ix - bx * I(8)) + (iy - by * I(8)) * I(E) + (iz - bz * I(8)) * I(E * E);
+        const I start =
+            haveStart ? *knownStart : gather(s.template entryStart<L>(), bx + by * I(s.nbx) + bz * I(s.nbxy));
+        const I base = start + (ix - bx * I(8)) + (iy - by * I(8)) * I(R) + (iz - bz * I(8)) * I(S);
+        // rows (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1): a = x, b = x + 1
         P a0, b0, a1, b1, a2, b2, a3, b3;
-        fetchPair<typename Scene::Voxel, W>(s.voxels, base, a0, b0);
-        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(E), a1, b1);
-        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(E * E), a2, b2);
-        fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(E * E + E), a3, b3);
+        if constexpr (L == VoxelLayout::YPairs) {
+            fetchQuad<typename Scene::Voxel, W>(s.pairVoxels, base, a0, a1, b0, b1);
+            fetchQuad<typename Scene::Voxel, W>(s.pairVoxels, base + I(S), a2, a3, b2, b3);
+        } else {
+            fetchPair<typename Scene::Voxel, W>(s.voxels, base, a0, b0);
+            fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(R), a1, b1);
+            fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(S), a2, b2);
+            fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(S + R), a3, b3);
+        }
         const P c0 = a0 + (b0 - a0) * fx, c1 = a1 + (b1 - a1) * fx, c2 = a2 + (b2 - a2) * fx, c3 = a3 + (b3 - a3) * fx;
         const P d0 = c0 + (c1 - c0) * fy, d1 = c2 + (c3 - c2) * fy;
         return d0 + (d1 - d0) * fz;
@@ -91,14 +106,14 @@ struct VolumeIntegrator {
                 clamp(p.z, P(0.0f), P(s.clampHi.z))};
     }
     // Central-difference gradient in world units (stored values per world distance).
-    template <int W, class Scene>
+    template <int W, VoxelLayout L = VoxelLayout::Rows, class Scene>
     static Vec3<W> gradient(const Scene& s, const Vec3<W>& p) {
         Vec3<W> g;
         for (int a = 0; a < 3; ++a) {
             Vec3<W> lo = p, hi = p;
             lo[a] = lo[a] - Packet<W>(1.0f);
             hi[a] = hi[a] + Packet<W>(1.0f);
-            g[a] = (sample<W>(s, clampToGrid<W>(s, hi)) - sample<W>(s, clampToGrid<W>(s, lo))) *
+            g[a] = (sample<W, L>(s, clampToGrid<W>(s, hi)) - sample<W, L>(s, clampToGrid<W>(s, lo))) *
                    Packet<W>(0.5f * s.invSpacing[a]);
         }
         return g;
@@ -119,7 +134,7 @@ struct VolumeIntegrator {
         return toInt(clamp(v * P(s.tfMul) + P(s.tfAdd), P(0.0f), P(float(s.tf.size - 1))));
     }
 
-    template <int W, class Scene>
+    template <int W, VoxelLayout L, class Scene>
     void march(const Scene& s, const Vec3<W>& o, const Vec3<W>& d, const Packet<W>& tMin, const Packet<W>& tMax,
                const Mask<W>& act, Vec3<W>& col, Packet<W>& alpha, Packet<W>& depth, uint64_t& samples,
                float& skipped) const {
@@ -195,7 +210,7 @@ struct VolumeIntegrator {
                     // distance to the nearest brick that is not skipped
                     const I info = gather(s.brickInfo.data(), cid);
                     empty = alive & (info < I(0));
-                    start = (info & I(Scene::kPoolMask)) * I(Scene::kBrick);
+                    start = (info & I(Scene::kPoolMask)) * I(Scene::template kBrickStride<L>);
                     haveStart = true;
                     if (adaptive) {
                         const I l = shiftRight<W>(info, 28) & I(3);
@@ -221,7 +236,7 @@ struct VolumeIntegrator {
             if (any(samp)) {
                 sampleCount = sampleCount + select(samp, I(1), I(0));
                 // sampling lanes have not moved since the brick lookup; the others are masked
-                const P v = haveStart ? sample<W>(s, p, &start) : sample<W>(s, p);
+                const P v = haveStart ? sample<W, L>(s, p, &start) : sample<W, L>(s, p);
                 if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
                     const I idx = tfIndex<W>(s, v);
                     // interleaved RGBA table: (b, a) first, (r, g) only if something is visible
@@ -234,7 +249,7 @@ struct VolumeIntegrator {
                         P tr, tg;
                         fetchFloatPair<W>(s.rgbaSteps.data(), pair, tr, tg);
                         Vec3<W> c(tr, tg, tb);
-                        if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W>(s, p), d);
+                        if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W, L>(s, p), d);
                         const P w = (P(1.0f) - alpha) * a;
                         col += c * w;
                         alpha += w;
@@ -251,14 +266,14 @@ struct VolumeIntegrator {
                         const Mask<W> prevBelow = prev < isoV;
                         for (int it = 0; it < 12; ++it) {
                             const P mid = P(0.5f) * (lo + hi);
-                            const P vm = sample<W>(s, clampToGrid<W>(s, oi + di * mid));
+                            const P vm = sample<W, L>(s, clampToGrid<W>(s, oi + di * mid));
                             const Mask<W> sameAsPrev = ~((vm < isoV) ^ prevBelow);
                             lo = select(sameAsPrev, mid, lo);
                             hi = select(sameAsPrev, hi, mid);
                         }
                         const P th = P(0.5f) * (lo + hi);
                         const Vec3<W> ph = clampToGrid<W>(s, oi + di * th);
-                        const Vec3<W> g = gradient<W>(s, ph);
+                        const Vec3<W> g = gradient<W, L>(s, ph);
                         const I idx = tfIndex<W>(s, isoV);
                         const Vec3<W> c(gather(s.tf.r.data(), idx), gather(s.tf.g.data(), idx),
                                         gather(s.tf.b.data(), idx));

@@ -36,12 +36,37 @@ struct VolumeRenderSettings {
     Vec3f latticeLo, latticeHi;
 };
 
+// Where the march reads voxels from. Chosen once per packet march (VolumeIntegrator::
+// eval), a closed list of template arguments, so the sampling code has no per-sample test.
+enum class VoxelLayout {
+    Rows,    // the brick pool: x-rows of kEdge samples
+    YPairs,  // BrickedVolume::pairs (u8/u16): entries of two y-neighbours
+};
+
 template <class T>
 struct VolumeScene {
     using Voxel = T;
     static constexpr int kCells = BrickedVolume::kCells, kEdge = BrickedVolume::kEdge, kBrick = BrickedVolume::kBrick;
+    // Entries per brick, y row and z slice of layout L (an entry: a sample, or a y-pair).
+    template <VoxelLayout L>
+    static constexpr int kBrickStride = L == VoxelLayout::YPairs ? BrickedVolume::kPairEntries : kBrick;
+    template <VoxelLayout L>
+    static constexpr int kRowStride = L == VoxelLayout::YPairs ? BrickedVolume::kPairRow : kEdge;
+    template <VoxelLayout L>
+    static constexpr int kSliceStride = L == VoxelLayout::YPairs ? BrickedVolume::kPairSlice : kEdge* kEdge;
     const T* voxels = nullptr;  // brick pool
     const int32_t* brickStart = nullptr;
+    // The y-pair copy (null when the volume has none) and per brick its first entry.
+    const T* pairVoxels = nullptr;
+    std::vector<int32_t> pairStart;
+    template <VoxelLayout L>
+    const T* entries() const {
+        return L == VoxelLayout::YPairs ? pairVoxels : voxels;
+    }
+    template <VoxelLayout L>
+    const int32_t* entryStart() const {
+        return L == VoxelLayout::YPairs ? pairStart.data() : brickStart;
+    }
     int dims[3] = {0, 0, 0};
     int32_t nbx = 0, nbxy = 0;  // brick grid strides
     Vec3f origin, invSpacing, spacing;
@@ -76,6 +101,12 @@ struct VolumeScene {
         }
         voxels = v.data<T>();
         brickStart = v.brickStart.data();
+        if (sizeof(T) < 4 && !v.pairs.empty()) {
+            pairVoxels = reinterpret_cast<const T*>(v.pairs.data());
+            pairStart.resize(v.brickStart.size());
+            for (size_t i = 0; i < pairStart.size(); ++i)
+                pairStart[i] = v.brickStart[i] / kBrick * BrickedVolume::kPairEntries;
+        }
         nbx = v.nb[0];
         nbxy = v.nb[0] * v.nb[1];
         origin = v.origin;

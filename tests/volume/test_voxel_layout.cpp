@@ -1,0 +1,139 @@
+// The y-pair voxel layout (BrickedVolume::pairs): its trilinear samples equal the brick
+// pool's bit for bit and a brute-force trilinear over BrickedVolume::stored, at random
+// positions of u8 and u16 volumes whose sizes are not brick multiples; f32 has no pairs;
+// a march from either layout gives the same image.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/render/framebuffer.h"
+#include "core/render/pinhole_camera.h"
+#include "core/render/pixel_center_sampler.h"
+#include "core/render/ray_tracing_renderer.h"
+#include "core/render/tile_scheduler.h"
+#include "volume/volume_generators.h"
+#include "volume/volume_integrator.h"
+#include "volume/volume_scene.h"
+
+using namespace rtfact;
+using namespace rtfact::volume;
+
+namespace {
+
+constexpr int kW = simd::kNativeWidth;
+
+template <class T>
+VolumeGrid randomGrid(Storage st, float maxValue) {
+    VolumeGrid g;
+    g.dims[0] = 37;
+    g.dims[1] = 26;
+    g.dims[2] = 19;
+    g.allocate(st);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, maxValue);
+    for (size_t n = 0; n < g.voxelCount(); ++n) g.data<T>()[n] = T(u(rng));
+    // a zero region, so some bricks are the shared zero brick
+    for (int k = 0; k < 9; ++k)
+        for (int j = 0; j < 9; ++j)
+            for (int i = 0; i < 17; ++i) g.data<T>()[g.index(i, j, k)] = T(0);
+    return g;
+}
+
+// The trilinear sample in the integrator's arithmetic order, from BrickedVolume::stored.
+float bruteForce(const BrickedVolume& v, Vec3f p) {
+    const int ix = int(p.x), iy = int(p.y), iz = int(p.z);
+    const float fx = p.x - float(ix), fy = p.y - float(iy), fz = p.z - float(iz);
+    auto row = [&](int j, int k) {
+        const float a = v.stored(ix, j, k), b = v.stored(ix + 1, j, k);
+        return a + (b - a) * fx;
+    };
+    const float c0 = row(iy, iz), c1 = row(iy + 1, iz), c2 = row(iy, iz + 1), c3 = row(iy + 1, iz + 1);
+    const float d0 = c0 + (c1 - c0) * fy, d1 = c2 + (c3 - c2) * fy;
+    return d0 + (d1 - d0) * fz;
+}
+
+template <class T>
+void checkLayouts(Storage st, float maxValue) {
+    const BrickedVolume bv = brickVolume(randomGrid<T>(st, maxValue));
+    ASSERT_FALSE(bv.pairs.empty()) << "a small u8/u16 volume gets y-pairs";
+    EXPECT_LT(bv.storedBricks(), bv.brickCount());
+    // 8 y-pairs x 9 x 9 entries of two samples per stored brick (and the zero brick)
+    EXPECT_EQ(bv.pairs.size(), (bv.storedBricks() + 1) * size_t(BrickedVolume::kPairEntries) * 2 * sizeof(T) + 64);
+    TransferFunction tf = transferFunctionPreset("grayscale");
+    const VolumeScene<T> s(bv, buildTable(tf, {0.0f, maxValue}, 0.5f), {});
+    ASSERT_NE(s.pairVoxels, nullptr);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int it = 0; it < 400; ++it) {
+        Vec3<kW> p;
+        for (int i = 0; i < kW; ++i) {
+            Vec3f q(u(rng) * float(bv.dims[0] - 1), u(rng) * float(bv.dims[1] - 1), u(rng) * float(bv.dims[2] - 1));
+            if (it == 0 && i == 0) q = Vec3f(float(bv.dims[0] - 1), float(bv.dims[1] - 1), float(bv.dims[2] - 1));
+            if (it == 1) q[i % 3] = float((i / 3) * 8 % (bv.dims[i % 3] - 1));  // on brick faces
+            p.setLane(i, q);
+        }
+        const Vec3<kW> c = VolumeIntegrator::clampToGrid<kW>(s, p);
+        const Packet<kW> rows = VolumeIntegrator::sample<kW, VoxelLayout::Rows>(s, c);
+        const Packet<kW> pairs = VolumeIntegrator::sample<kW, VoxelLayout::YPairs>(s, c);
+        for (int i = 0; i < kW; ++i) {
+            const Vec3f q(c.x[i], c.y[i], c.z[i]);
+            ASSERT_EQ(pairs[i], rows[i]) << q.x << "," << q.y << "," << q.z;
+            const Packet<1> one =
+                VolumeIntegrator::sample<1, VoxelLayout::YPairs>(s, VolumeIntegrator::clampToGrid<1>(s, Vec3<1>(q)));
+            ASSERT_EQ(float(one), pairs[i]) << q.x << "," << q.y << "," << q.z;
+            const float ref = bruteForce(bv, q);
+            ASSERT_NEAR(pairs[i], ref, 1e-5f * std::max(1.0f, std::fabs(ref))) << q.x << "," << q.y << "," << q.z;
+        }
+    }
+}
+
+std::vector<float> renderDvr(const BrickedVolume& bv, VolumeMode mode) {
+    const TransferFunction tf = transferFunctionPreset("ct-bone");
+    const auto [lo, hi] = bv.valueRange();
+    VolumeRenderSettings rs;
+    rs.mode = mode;
+    rs.iso = lo + 0.4f * (hi - lo);
+    const TFTable table = buildTable(tf, {lo, hi}, rs.stepVoxels);
+    std::vector<float> out;
+    withVolumeScene(bv, table, rs, [&](const auto& scene) {
+        const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}), 64, 64);
+        RGBAFramebuffer fb(64, 64);
+        RenderOptions ro;
+        ro.progress = false;
+        renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+        out = fb.resolved(1);
+    });
+    return out;
+}
+
+}  // namespace
+
+TEST(VoxelLayout, YPairsEqualRowsU8) { checkLayouts<uint8_t>(Storage::U8, 255.0f); }
+TEST(VoxelLayout, YPairsEqualRowsU16) { checkLayouts<uint16_t>(Storage::U16, 65535.0f); }
+
+TEST(VoxelLayout, F32HasNoPairs) {
+    const BrickedVolume bv = brickVolume(randomGrid<float>(Storage::F32, 1.0f));
+    EXPECT_TRUE(bv.pairs.empty());
+    const VolumeScene<float> s(bv, buildTable(transferFunctionPreset("grayscale"), {0.0f, 1.0f}, 0.5f), {});
+    EXPECT_EQ(s.pairVoxels, nullptr);
+}
+
+// Without the y-pairs (the memory budget's fallback) the march reads the pool: same image,
+// in every mode.
+TEST(VoxelLayout, ImagesEqualWithoutPairs) {
+    BrickedVolume with = brickVolume(makeSheppLogan(45, Storage::U16));
+    BrickedVolume without = with;
+    without.pairs.clear();
+    ASSERT_FALSE(with.pairs.empty());
+    for (VolumeMode m : {VolumeMode::DVR, VolumeMode::Shaded, VolumeMode::MIP, VolumeMode::Iso}) {
+        const std::vector<float> a = renderDvr(with, m), b = renderDvr(without, m);
+        ASSERT_EQ(a.size(), b.size());
+        float maxDiff = 0, sum = 0;
+        for (size_t i = 0; i < a.size(); ++i) {
+            maxDiff = std::max(maxDiff, std::fabs(a[i] - b[i]));
+            sum += a[i];
+        }
+        EXPECT_EQ(maxDiff, 0.0f) << int(m);
+        EXPECT_GT(sum, 0.0f) << int(m);  // something was drawn
+    }
+}
