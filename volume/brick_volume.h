@@ -36,7 +36,9 @@ struct BrickedVolume {
     // pair brick b of kPairEntries entries; entry (x, y, z), y < kCells, holds the samples
     // (x, y, z) and (x, y + 1, z), so one 32-bit (u8) or 64-bit (u16) load at (x, y, z)
     // returns the four corners of a cell face: a trilinear sample is 2 gathers, not 4.
-    // Empty when the memory budget did not allow it (the march then reads the pool).
+    // Built only while it stays cache-sized (<= 16 MB: faster there, slower on large
+    // volumes, where the march waits on cache misses) and the memory budget allows it;
+    // empty otherwise, and the march reads the pool.
     static constexpr int kPairRow = kEdge, kPairSlice = kEdge * kCells, kPairEntries = kPairSlice * kEdge;
     std::vector<uint8_t> pairs;
 
@@ -82,8 +84,9 @@ struct BrickBuilder {
     static void finish(BrickedVolume& v);
 };
 
-// Builds v.pairs from v.pool for u8/u16 volumes when the memory budget allows it
-// (1.78x the pool; core/util/memory_budget.h), else leaves it empty. Returns whether built.
+// Builds v.pairs from v.pool for u8/u16 volumes when the copy (1.78x the pool) is at most
+// 16 MB and the memory budget allows it (core/util/memory_budget.h), else leaves it
+// empty. Returns whether built.
 bool buildPairs(BrickedVolume& v);
 
 template <class F>
