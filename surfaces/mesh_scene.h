@@ -115,8 +115,9 @@ struct MeshScene {
     // directly with SIMD blocks of triangles as leaves (BVH scenes only; kd-tree scenes
     // answer them with `accel`).
     bool buildWide = true;  // set before build()
-    // Coherent rays (primary, shadow, packet secondaries) take the binary packet BVH
-    // when it is built, else the wide BVH's packet traversal (WideBVHPacketIntersector).
+    // Coherent rays (primary, packet secondaries) take the binary packet BVH when it is
+    // built, else the wide BVH's packet traversal (WideBVHPacketIntersector); coherent
+    // shadow rays take the wide packets whenever the wide BVH exists (occluded()).
     // The binary one is built for meshes of at most packetBVHMaxTriangles (0: never):
     // measured (quiet, AVX-512 and AVX2 builds, docs/benchmarks.md) its primary rays are
     // 1.2-1.3x the wide packets' on the 100k-triangle dragon, while from 278k triangles
@@ -193,9 +194,12 @@ struct MeshScene {
         if (coherentWide()) return widePacketTracer.template intersect<HitData::Distance>(wide, rays, active);
         return tracer.template intersect<HitData::Distance>(accel, rays, active);
     }
+    // Shadow rays take the wide packets whenever the wide BVH exists: on the 100k dragon
+    // too they were 1.07-1.21x the binary BVH's in every quiet run (session s6, AVX-512 and
+    // AVX2 builds, 1 and 2 threads), where primary rays keep the binary BVH.
     template <int N>
     Mask<N> occluded(const RayPacket<N>& rays, const Mask<N>& active) const {
-        if (coherentWide()) return widePacketTracer.occluded(wide, rays, active);
+        if (hasWide()) return widePacketTracer.occluded(wide, rays, active);
         return tracer.occluded(accel, rays, active);
     }
 
