@@ -60,10 +60,6 @@ struct VolumeScene {
     const T* pairVoxels = nullptr;
     std::vector<int32_t> pairStart;
     template <VoxelLayout L>
-    const T* entries() const {
-        return L == VoxelLayout::YPairs ? pairVoxels : voxels;
-    }
-    template <VoxelLayout L>
     const int32_t* entryStart() const {
         return L == VoxelLayout::YPairs ? pairStart.data() : brickStart;
     }
