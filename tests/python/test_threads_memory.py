@@ -8,16 +8,14 @@ import numpy as np
 import rtfact
 
 
-def test_python_thread_runs_during_render():
-    z, y, x = np.mgrid[-1:1:96j, -1:1:96j, -1:1:96j]
-    vol = (np.exp(-2 * (x ** 2 + y ** 2 + z ** 2)) * 60000).astype(np.uint16)
-    scene = rtfact.volume(vol)
+def render_beside_a_ticking_thread(scene, spp):
+    """Renders on a worker thread while this one ticks every 2 ms; returns (t0, t1, ticks)."""
     done = threading.Event()
     span = {}
 
     def work():
         t0 = time.monotonic()
-        rtfact.render(scene, size=(320, 320), spp=12, threads=1, step=0.25)
+        rtfact.render(scene, size=(320, 320), spp=spp, threads=1, step=0.25)
         span["t"] = (t0, time.monotonic())
         done.set()
 
@@ -28,9 +26,23 @@ def test_python_thread_runs_during_render():
         ticks.append(time.monotonic())
         time.sleep(0.002)
     t.join()
-    t0, t1 = span["t"]
-    duration = t1 - t0
-    assert duration > 0.2, f"render too short ({duration:.3f} s) to tell"
+    return span["t"][0], span["t"][1], ticks
+
+
+def test_python_thread_runs_during_render():
+    z, y, x = np.mgrid[-1:1:96j, -1:1:96j, -1:1:96j]
+    vol = (np.exp(-2 * (x ** 2 + y ** 2 + z ** 2)) * 60000).astype(np.uint16)
+    scene = rtfact.volume(vol)
+    # The render must last long enough to tell a held GIL from a released one; how long a
+    # given spp takes depends on the CPU and the kernel, so double spp until it does.
+    spp = 12
+    while True:
+        t0, t1, ticks = render_beside_a_ticking_thread(scene, spp)
+        duration = t1 - t0
+        if duration > 0.3 or spp >= 12 * 64:
+            break
+        spp *= 2
+    assert duration > 0.2, f"render too short ({duration:.3f} s at spp {spp}) to tell"
     inside = [s for s in ticks if t0 <= s <= t1]
     gaps = np.diff([t0] + inside + [t1])
     # With the GIL held by the render, this thread would stop for the whole render.
