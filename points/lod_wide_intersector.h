@@ -5,9 +5,15 @@
 // child's box (the camera cone, width(t) = base + slope * t, unit directions), and one
 // SIMD disc test intersects the ray with the cut children's representatives (hit at
 // `repScale` of their covering radius, as the kd-tree's). The other children are visited
-// near to far. Quality 0 is full detail. Packets go lane by lane: the cut then follows
-// each ray's own footprint.
+// near to far. Quality 0 is full detail.
+// Packets go through the tree a native chunk of W rays at a time (traverseChunk): the
+// levels above the cut are then fetched once per chunk instead of once per ray, which
+// is where single rays spend their time on large clouds (dependent misses ~15 levels
+// deep). The cut stays each ray's own (its footprint at its own entry into the child's
+// box), so a packet answers every ray as a single ray would (up to the visiting order of
+// representatives that reach outside their boxes).
 #pragma once
+#include "core/accel/wide_bvh_packet_intersector.h"
 #include "core/concepts/camera.h"
 #include "core/concepts/intersector.h"
 #include "core/util/assert.h"
@@ -24,37 +30,36 @@ struct LoDWideIntersector {
     template <int N>
     using Hit = DiscIntersector::Hit<N>;
 
+    // Chunks reached by at most this fraction of their lanes (at least one) go on as single
+    // rays; leaves reached by at most singleRayLeafFraction of them test their blocks
+    // lane by lane (one SIMD test over a block's discs per ray), else disc by disc for the
+    // chunk's lanes at once.
+    float singleRayFraction = 0.25f;
+    float singleRayLeafFraction = 0.5f;
+
     template <bool CommonOrigin, HitData D, int N>
     void intersect(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
         hit.t = rays.tMax;
         hit.id = Packet<N, int32_t>(-1);
         if constexpr (N == 1) {
-            if (active[0]) traverse<D, false>(bvh, rays, hit);
+            if (active[0]) traverse<D, false>(bvh, rays, hit, 0);
         } else {
-            BitMask<N>(active).forEach([&](int i) {
-                const RayPacket<1> r = rays.lane(i);
-                Hit<1> h;
-                h.t = r.tMax;
-                h.id = -1;
-                traverse<D, false>(bvh, r, h);
-                hit.t[i] = float(h.t);
-                hit.id[i] = int32_t(h.id);
-            });
+            tracePacket<CommonOrigin, D, false>(bvh, rays, hit, active);
+            hit.t = select(active, hit.t, rays.tMax);
         }
     }
 
     template <bool CommonOrigin, int N>
     Mask<N> occluded(const LoDWideBVH& bvh, const RayPacket<N>& rays, const Mask<N>& active) const {
-        Mask<N> occ(false);
-        BitMask<N>(active).forEach([&](int i) {
-            Hit<1> h;
-            const RayPacket<1> r = rays.lane(i);
-            h.t = r.tMax;
-            h.id = -1;
-            traverse<HitData::Distance, true>(bvh, r, h);
-            if (int32_t(h.id) != -1) occ.set(i, true);
-        });
-        return occ;
+        Hit<N> hit;
+        hit.t = rays.tMax;
+        hit.id = Packet<N, int32_t>(-1);
+        if constexpr (N == 1) {
+            if (active[0]) traverse<HitData::Distance, true>(bvh, rays, hit, 0);
+        } else {
+            tracePacket<CommonOrigin, HitData::Distance, true>(bvh, rays, hit, active);
+        }
+        return active & (hit.id != Packet<N, int32_t>(-1));
     }
 
    private:
@@ -111,7 +116,7 @@ struct LoDWideIntersector {
     // Closest hit: children hit are visited near to far and a popped entry is skipped once
     // a closer hit is known. Any hit: no ordering.
     template <HitData D, bool AnyHit>
-    void traverse(const LoDWideBVH& bvh, const RayPacket<1>& ray, Hit<1>& hit) const {
+    void traverse(const LoDWideBVH& bvh, const RayPacket<1>& ray, Hit<1>& hit, int32_t start) const {
         if (bvh.nodes.empty()) return;
         const WideBVHNode<K>* nodes = bvh.nodes.data();
         int nearOff[3], farOff[3];
@@ -133,7 +138,7 @@ struct LoDWideIntersector {
         };
         Entry stack[(K - 1) * LoDWideBVH::kMaxDepth + 1];
         int sp = 0;
-        int32_t node = 0;
+        int32_t node = start;
         for (;;) {
             const WideBVHNode<K>& n = nodes[node];
             const float* f = n.lo[0];
@@ -191,6 +196,234 @@ struct LoDWideIntersector {
                     break;
                 }
                 if (leaf<D, AnyHit>(bvh, e.child, e.count, ray, hit)) return;
+            }
+        }
+    }
+
+    // The packet chunk by chunk, its lanes regrouped so that each chunk is a compact tile
+    // of the image (the core's ChunkTiles order) when the packet has one. Inactive and
+    // finished (any hit) lanes carry hit.t = -inf: no box test passes for them.
+    template <bool CommonOrigin, HitData D, bool AnyHit, int N>
+    void tracePacket(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
+        if (bvh.nodes.empty()) return;
+        hit.t = select(active, hit.t, Packet<N>(-kInfinity));
+        using T = typename WideBVHPacketIntersector<DiscBlockIntersector>::template ChunkTiles<N>;
+        if constexpr (Packet<N>::W < 4) {
+            BitMask<N>(active).forEach([&](int i) { singleLane<D, AnyHit>(bvh, rays, hit, i, 0); });
+        } else if constexpr (T::kEnabled) {
+            RayPacket<N> r;
+            Hit<N> h;
+            r.commonOrigin = rays.commonOrigin;
+            for (int i = 0; i < N; ++i) {
+                const int j = T::perm[size_t(i)];
+                for (int a = 0; a < 3; ++a) {
+                    r.org[a][i] = rays.org[a][j];
+                    r.dir[a][i] = rays.dir[a][j];
+                    r.invDir[a][i] = rays.invDir[a][j];
+                }
+                r.tMin[i] = rays.tMin[j];
+                r.tMax[i] = rays.tMax[j];
+                h.t[i] = hit.t[j];
+            }
+            h.id = Packet<N, int32_t>(-1);
+            traceChunks<CommonOrigin, D, AnyHit>(bvh, r, h);
+            for (int i = 0; i < N; ++i) {
+                const int j = T::perm[size_t(i)];
+                hit.t[j] = h.t[i];
+                hit.id[j] = h.id[i];
+            }
+        } else {
+            traceChunks<CommonOrigin, D, AnyHit>(bvh, rays, hit);
+        }
+    }
+
+    template <bool CommonOrigin, HitData D, bool AnyHit, int N>
+    void traceChunks(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit) const {
+        const BitMask<N> bits(hit.t > Packet<N>(-kInfinity));
+        for (int k = 0; k < Packet<N>::C; ++k)
+            if (const uint32_t lanes = bits.chunkBits(k))
+                traverseChunk<CommonOrigin, D, AnyHit>(bvh, rays, hit, k, lanes);
+    }
+
+    // Packet lane i as a single ray from inner node `start`; the result goes back into hit.
+    template <HitData D, bool AnyHit, int N>
+    RTFACT_INLINE void singleLane(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, int i,
+                                  int32_t start) const {
+        const RayPacket<1> r = rays.lane(i);
+        Hit<1> h;
+        h.t = hit.t[i];
+        h.id = -1;
+        traverse<D, AnyHit>(bvh, r, h, start);
+        if (int32_t(h.id) == -1) return;
+        hit.t[i] = AnyHit ? -kInfinity : float(h.t);  // any hit: done, no box test passes any more
+        hit.id[i] = int32_t(h.id);
+    }
+
+    // The lanes of a W-lane chunk given as bits, as a lane mask.
+    template <int W>
+    static RTFACT_INLINE Mask<W> laneMask(uint32_t bits) {
+        using PI = Packet<W, int32_t>;
+        static const PI laneBit = [] {
+            PI p;
+            for (int i = 0; i < W; ++i) p[i] = int32_t(1u << i);
+            return p;
+        }();
+        return (PI(int32_t(bits)) & laneBit) != PI(0);
+    }
+
+    // Chunk k (active lanes `lanes`) through the tree. Per node, one interval test culls
+    // the K children for the whole chunk (core WideFrustum), then each candidate is tested
+    // against the chunk's lanes; the lanes whose footprint at their entry covers the
+    // child's representative are answered by it (one disc test for those lanes), the
+    // others descend. Entries reached by few lanes continue as single rays.
+    template <bool CommonOrigin, HitData D, bool AnyHit, int N>
+    void traverseChunk(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, int k, uint32_t lanes) const {
+        constexpr int W = Packet<N>::W;
+        static_assert(W <= 32, "lane masks are 32 bits");
+        using PW = Packet<W>;
+        const int singleLanes = std::max(1, int(singleRayFraction * float(W)));
+        const int singleLeafLanes = std::max(1, int(singleRayLeafFraction * float(W)));
+        if (__builtin_popcount(lanes) <= singleLanes) {
+            for (uint32_t b = lanes; b; b &= b - 1) singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), 0);
+            return;
+        }
+        uint32_t open = lanes;  // lanes still searching (any hit: without an occluder)
+        PW org[3], inv[3];
+        for (int a = 0; a < 3; ++a) {
+            inv[a] = rays.invDir[a].chunk(k);
+            org[a] = CommonOrigin ? PW(rays.org[a][0]) : rays.org[a].chunk(k);
+        }
+        const PW& tMin = rays.tMin.chunk(k);
+        WideFrustum fr;
+        fr.template init<K, W>(org, inv, tMin, hit.t.chunk(k) > PW(-kInfinity), CommonOrigin);
+        fr.tMaxHi = hmax(hit.t.chunk(k));
+        const bool uniform = fr.uniform;
+        const bool lod = quality > 0.0f;
+        const PW cutBase(0.5f * quality * cone.base), cutSlope(0.5f * quality * cone.slope);
+        const PW inf(kInfinity);
+        // Slab test of the chunk's lanes against child c of the node with bounds f, up to
+        // each lane's current hit; tn receives the entry distances.
+        auto laneHits = [&](const float* f, int c, PW& tn) __attribute__((always_inline)) {
+            PW tf = hit.t.chunk(k);
+            tn = tMin;
+            for (int a = 0; a < 3; ++a) {
+                const PW t0 = (PW(f[a * K + c]) - org[a]) * inv[a], t1 = (PW(f[3 * K + a * K + c]) - org[a]) * inv[a];
+                tn = max(tn, min(t0, t1));
+                tf = min(tf, max(t0, t1));
+            }
+            return uint32_t(BitMask<W>(tn <= tf).w[0]);
+        };
+        // Any hit: lanes that found an occluder leave the traversal.
+        auto retire = [&]() {
+            const Mask<W> found = hit.id.chunk(k) != Packet<W, int32_t>(-1);
+            hit.t.chunk(k) = select(found, PW(-kInfinity), hit.t.chunk(k));
+            open &= ~uint32_t(BitMask<W>(found).w[0]);
+        };
+        // An entry remembers its parent and slot, so its lanes are tested again against the
+        // hits found since it was pushed.
+        struct Entry {
+            int32_t child, count;
+            float dist;
+            uint32_t lanes;
+            int32_t parent, slot;
+        };
+        Entry stack[(K - 1) * LoDWideBVH::kMaxDepth + 1];
+        int sp = 0;
+        int32_t node = 0;
+        uint32_t nodeLanes = lanes;
+        for (;;) {
+            const WideBVHNode<K>& n = bvh.nodes[size_t(node)];
+            const float* f = n.lo[0];
+            P entry;
+            uint64_t cand = fr.template children<CommonOrigin, K>(f, entry);
+            const int base = sp;
+            RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the stack");
+            for (; cand; cand &= cand - 1) {
+                const int c = __builtin_ctzll(cand);
+                PW tn;
+                uint32_t m = laneHits(f, c, tn) & nodeLanes;
+                if (!m) continue;
+                if (lod) {
+                    // Cut where 2 radius <= quality (base + slope t) at the lane's own entry.
+                    const LoDChildReps<K>& r = bvh.childReps[size_t(node)];
+                    const uint32_t cut =
+                        m & uint32_t(BitMask<W>(PW(r.radius[c]) <= cutBase + cutSlope * max(tn, PW(0.0f))).w[0]);
+                    if (cut) {
+                        const float rr = r.radius[c] * repScale;
+                        DiscIntersector::intersectDiscChunk(Vec3f(r.c[0][c], r.c[1][c], r.c[2][c]),
+                                                            Vec3f(r.n[0][c], r.n[1][c], r.n[2][c]), rr * rr,
+                                                            LoDWideBVH::repId(node, c), rays, hit, k, laneMask<W>(cut));
+                        if constexpr (AnyHit) {
+                            retire();
+                            if (!open) return;
+                        }
+                        m &= ~cut;
+                        if (!m) continue;
+                    }
+                }
+                Entry e{n.child[c], n.count[c], 0.0f, m, node, c};
+                if (e.count == 0) prefetchNode(bvh, e.child);
+                if constexpr (AnyHit) {
+                    stack[sp++] = e;
+                } else {
+                    // The interval entry bounds the lanes' entries from below: it orders the
+                    // children without a horizontal minimum per child.
+                    e.dist = uniform ? entry[c] : hmin(select(tn <= hit.t.chunk(k), tn, inf));
+                    pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
+                }
+            }
+            // Pop the nearest entry that can still hold a closer hit; run leaves and hand
+            // entries with few lanes to single rays.
+            for (;;) {
+                if (sp == 0) return;
+                Entry e = stack[--sp];
+                if constexpr (AnyHit) {
+                    e.lanes &= open;
+                } else {
+                    if (!(e.dist <= fr.tMaxHi)) continue;
+                    PW tn;
+                    e.lanes &= laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn);
+                }
+                if (!e.lanes) continue;
+                const int lanesHit = __builtin_popcount(e.lanes);
+                if (e.count == 0) {
+                    if (lanesHit > singleLanes) {
+                        node = e.child;
+                        nodeLanes = e.lanes;
+                        break;
+                    }
+                    for (uint32_t b = e.lanes; b; b &= b - 1)
+                        singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), e.child);
+                } else if (lanesHit <= singleLeafLanes) {
+                    for (uint32_t b = e.lanes; b; b &= b - 1) {
+                        const int i = k * W + __builtin_ctz(b);
+                        const RayPacket<1> r = rays.lane(i);
+                        Hit<1> h;
+                        h.t = hit.t[i];
+                        h.id = -1;
+                        leaf<D, AnyHit>(bvh, e.child, e.count, r, h);
+                        if (int32_t(h.id) == -1) continue;
+                        hit.t[i] = float(h.t);
+                        hit.id[i] = int32_t(h.id);
+                    }
+                } else {
+                    const Mask<W> m = laneMask<W>(e.lanes);
+                    const auto* blocks = bvh.blocks.data() + e.child;
+                    for (int j = 0; j * kDiscLeafBlock < e.count; ++j) {
+                        const auto& b = blocks[j];
+                        const int cnt = std::min(kDiscLeafBlock, e.count - j * kDiscLeafBlock);
+                        for (int i = 0; i < cnt; ++i)
+                            DiscIntersector::intersectDiscChunk(Vec3f(b.c[0][i], b.c[1][i], b.c[2][i]),
+                                                                Vec3f(b.n[0][i], b.n[1][i], b.n[2][i]), b.r2[i],
+                                                                b.id[i], rays, hit, k, m);
+                    }
+                }
+                if constexpr (AnyHit) {
+                    retire();
+                    if (!open) return;
+                } else {
+                    fr.tMaxHi = hmax(hit.t.chunk(k));
+                }
             }
         }
     }
