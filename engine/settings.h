@@ -32,6 +32,10 @@ struct PointSettings {
     float radius = 0.0f;           // > 0: one radius for every point
     float radiusFactor = 1.0f;     // times the spacing estimate or the file's radii
     int leafSize = 8;
+    // kd: the LoD kd-tree (~31 bytes per point); wide: the wide BVH of 8-disc blocks with
+    // child summaries in the parents, median split (~100 bytes per point, traces packets
+    // faster, docs/benchmarks.md). Full-detail images are the same with both.
+    std::string accel = "kd";
     int aoSamples = 8;
 };
 
@@ -80,6 +84,7 @@ struct Settings {
 
 // The closed name tables (what the CLI offers).
 const std::vector<std::string>& pointIntegrators();
+const std::vector<std::string>& pointAccels();
 const std::vector<std::string>& meshIntegrators();
 const std::vector<std::string>& volumeModes();
 const std::vector<std::string>& spheresIntegrators();

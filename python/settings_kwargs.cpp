@@ -125,7 +125,7 @@ surfaces::MeshMaterial materialArg(const std::string& spec) { return engine::par
 // The names each kind accepts besides the shared ones.
 const std::set<std::string>& namesOf(SceneKind k) {
     static const std::set<std::string> points{"integrator", "color",         "lod",       "lod_quality", "normals",
-                                              "radius",     "radius_factor", "leaf_size", "ao_samples"};
+                                              "radius",     "radius_factor", "leaf_size", "ao_samples",  "accel"};
     static const std::set<std::string> mesh{"integrator", "max_depth",  "light",    "material",
                                             "bvh",        "ao_samples", "secondary"};
     static const std::set<std::string> volume{
@@ -158,6 +158,7 @@ void applyPoints(engine::PointSettings& s, const std::string& k, py::handle v) {
     if (k == "radius") s.radius = positive(v, k);
     if (k == "radius_factor") s.radiusFactor = numberIn(v, k, 1e-3, 1e3);
     if (k == "leaf_size") s.leafSize = integerIn(v, k, 1, 64);
+    if (k == "accel") s.accel = choice(v, k, engine::pointAccels());
     if (k == "ao_samples") s.aoSamples = integerIn(v, k, 1, 256);
 }
 

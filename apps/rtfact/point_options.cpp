@@ -136,6 +136,11 @@ void PointOptions::addTo(CLI::App& cmd) {
     cmd.add_option("--leaf-size", ps.leafSize, "Maximum points per kd-tree leaf")
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
+    cmd.add_option("--accel", ps.accel,
+                   "Structure: kd (LoD kd-tree, ~31 bytes per point) | wide (wide BVH, ~100 bytes per point, "
+                   "faster to trace)")
+        ->capture_default_str()
+        ->check(CLI::IsMember(engine::pointAccels()));
 }
 
 engine::Settings PointOptions::toSettings() const {

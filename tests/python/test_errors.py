@@ -78,6 +78,7 @@ def cloud():
     ({"integrator": "foo"}, ValueError, "integrator: 'foo' is not one of eyelight, direct, ao"),
     ({"radius_factor": float("nan")}, ValueError, "radius_factor: expected a finite number, got nan"),
     ({"lod_quality": 100}, ValueError, "lod_quality: must be in [0.0, 64.0], got 100"),
+    ({"accel": "octree"}, ValueError, "accel: 'octree' is not one of kd, wide"),
     ({"size": (0, 10)}, ValueError, "size: must be in [1, 16384], got 0"),
     ({"size": "10by10"}, ValueError, "size: expected WxH"),
     ({"spp": 0}, ValueError, "spp: must be in [1,"),
