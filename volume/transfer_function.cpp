@@ -268,7 +268,6 @@ TFTable buildTable(const TransferFunction& tf, std::pair<float, float> window, f
     t.b.resize(size_t(t.size));
     t.a.resize(size_t(t.size));
     t.visiblePrefix.assign(size_t(t.size) + 1, 0);
-    t.rgba.resize(size_t(t.size) * 4);
     for (int i = 0; i < t.size; ++i) {
         const float u = float(i) / float(t.size - 1);
         const float x = tf.normalized ? u : t.lo + u * (t.hi - t.lo);
@@ -279,11 +278,6 @@ TFTable buildTable(const TransferFunction& tf, std::pair<float, float> window, f
         t.b[size_t(i)] = srgbToLinear(c.z);
         t.a[size_t(i)] = a >= 1.0f ? 1.0f : 1.0f - std::pow(1.0f - a, stepVoxels);
         t.visiblePrefix[size_t(i) + 1] = t.visiblePrefix[size_t(i)] + (t.a[size_t(i)] > 0.0f ? 1 : 0);
-        float* e = &t.rgba[size_t(i) * 4];
-        e[0] = t.r[size_t(i)];
-        e[1] = t.g[size_t(i)];
-        e[2] = t.b[size_t(i)];
-        e[3] = t.a[size_t(i)];
     }
     return t;
 }

@@ -55,7 +55,6 @@ struct TFTable {
     float lo = 0, hi = 1;
     int size = 0;
     std::vector<float> r, g, b, a;
-    std::vector<float> rgba;             // the same, interleaved: r g b a per entry (for 64-bit gathers)
     std::vector<int32_t> visiblePrefix;  // count of entries with a > 0 in [0, i)
     // Index of data value v (nearest entry, clamped).
     int index(float v) const;

@@ -194,7 +194,7 @@ struct VolumeIntegrator {
             I start(0);
             bool haveStart = false;
             P mStep(1.0f);  // step multiple of the lanes' bricks (opacity-adaptive steps)
-            I tfOffset(0);  // their TF table, in pairs of floats
+            I tfOffset(0);  // their TF table's first entry
             // Empty-space skipping: jump to the first sample position past the empty cube of
             // bricks around the lane's brick (one brick for MIP).
             {
@@ -215,7 +215,7 @@ struct VolumeIntegrator {
                     if (adaptive) {
                         const I l = shiftRight<W>(info, 28) & I(3);
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));
-                        tfOffset = l * I(2 * s.tf.size);
+                        tfOffset = l * I(s.tf.size);
                     }
                     reach = info & I(0x7fffffff);
                 }
@@ -238,16 +238,12 @@ struct VolumeIntegrator {
                 // sampling lanes have not moved since the brick lookup; the others are masked
                 const P v = haveStart ? sample<W, L>(s, p, &start) : sample<W, L>(s, p);
                 if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
-                    const I idx = tfIndex<W>(s, v);
-                    // interleaved RGBA table: (b, a) first, (r, g) only if something is visible
-                    P tb, ta;
-                    const I pair = idx * I(2) + tfOffset;
-                    fetchFloatPair<W>(s.rgbaSteps.data(), pair + I(1), tb, ta);
+                    // the whole RGBA entry in one 64-bit gather per lane
+                    P tr, tg, tb, ta;
+                    fetchRgbaHalf<W>(s.rgbaSteps.data(), tfIndex<W>(s, v) + tfOffset, tr, tg, tb, ta);
                     const P a = select(samp, ta, P(0.0f));
                     const Mask<W> contrib = a > P(0.0f);
                     if (any(contrib)) {
-                        P tr, tg;
-                        fetchFloatPair<W>(s.rgbaSteps.data(), pair, tr, tg);
                         Vec3<W> c(tr, tg, tb);
                         if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W, L>(s, p), d);
                         const P w = (P(1.0f) - alpha) * a;

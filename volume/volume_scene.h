@@ -10,6 +10,7 @@
 
 #include "core/util/error.h"
 #include "volume/brick_volume.h"
+#include "volume/half_float.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_grid.h"
 
@@ -83,9 +84,10 @@ struct VolumeScene {
     // bits 0-27, log2 of the step multiple in bits 28-29.
     std::vector<int32_t> brickInfo;
     static constexpr int32_t kSkipBit = int32_t(0x80000000u), kPoolMask = (1 << 28) - 1, kMaxDistance = 16;
-    // Transfer-function tables (interleaved r g b a) for 1, 2 and 4 steps: the opacity of
-    // table m is 1 - (1 - a)^m.
-    std::vector<float> rgbaSteps;
+    // Transfer-function tables for 1, 2 and 4 steps (tf.size entries each): r, g, b and
+    // the opacity 1 - (1 - a)^m of table m as four halves per entry (half_float.h), so that
+    // one 64-bit gather fetches an entry.
+    std::vector<uint64_t> rgbaSteps;
     std::vector<float> cellMax;
     float invCell = 1.0f / kCells;
 
@@ -140,13 +142,12 @@ struct VolumeScene {
             if (v.brickStart[i] / kBrick > kPoolMask) throw Error("", "volume too large for the brick table");
             brickInfo[i] = cellFlags[i] ? (v.brickStart[i] / kBrick) | (multiple[i] << 28) : (kSkipBit | dist[i]);
         }
-        rgbaSteps.resize(tf.rgba.size() * 3);
+        const size_t n = size_t(tf.size);
+        rgbaSteps.resize(n * 3);
         for (int m = 0; m < 3; ++m)
-            for (size_t e = 0; e < tf.rgba.size(); e += 4) {
-                float* d = &rgbaSteps[size_t(m) * tf.rgba.size() + e];
-                std::copy_n(&tf.rgba[e], 4, d);
-                d[3] = 1.0f - std::pow(1.0f - std::min(d[3], 1.0f), float(1 << m));
-            }
+            for (size_t e = 0; e < n; ++e)
+                rgbaSteps[size_t(m) * n + e] = packRgbaHalf(
+                    tf.r[e], tf.g[e], tf.b[e], 1.0f - std::pow(1.0f - std::min(tf.a[e], 1.0f), float(1 << m)));
         // MIP skips on stored maxima; a decreasing value map (negative scale) or no
         // skipping: never skip.
         if (v.scale < 0 || !s.skipping)

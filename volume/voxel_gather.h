@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "core/simd/packet.h"
+#include "volume/half_float.h"
 
 namespace rtfact::volume {
 
@@ -219,6 +220,70 @@ RTFACT_INLINE void fetchFloatPair(const float* base, const Packet<W, int32_t>& i
     for (int i = 0; i < W; ++i) {
         a[i] = base[2 * idx2[i]];
         b[i] = base[2 * idx2[i] + 1];
+    }
+}
+
+// One transfer-function entry per lane: r, g, b, a as four halves in 64 bits (half_float.h)
+// at base[idx], one 64-bit gather per lane; the halves are sorted by channel with byte and
+// dword shuffles, then converted with F16C.
+template <int W>
+RTFACT_INLINE void fetchRgbaHalf(const uint64_t* base, const Packet<W, int32_t>& idx, Packet<W>& r, Packet<W>& g,
+                                 Packet<W>& b, Packet<W>& a) {
+    if constexpr (Packet<W>::C > 1) {
+        for (int k = 0; k < Packet<W>::C; ++k)
+            fetchRgbaHalf<Packet<W>::W>(base, idx.chunk(k), r.chunk(k), g.chunk(k), b.chunk(k), a.chunk(k));
+        return;
+    }
+#if RTFACT_NATIVE_WIDTH == 8 && defined(__F16C__)
+    if constexpr (W == 8) {
+        using namespace simd;
+        // per 128 bits (two entries): r0 g0 b0 a0 r1 g1 b1 a1 -> r0 r1 g0 g1 b0 b1 a0 a1
+        const __m256i bytes = _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, 8, 9, 2, 3,
+                                               10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
+        const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+        const __m256i lo = _mm256_i32gather_epi64((const long long*)base, lowHalf8(idx.c[0]), 8);
+        const __m256i hi = _mm256_i32gather_epi64((const long long*)base, highHalf8(idx.c[0]), 8);
+        // lanes 0-3 (4-7): r r r r g g g g | b b b b a a a a
+        const __m256i l = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(lo, bytes), order);
+        const __m256i h = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hi, bytes), order);
+        const __m256i rb = _mm256_unpacklo_epi64(l, h), ga = _mm256_unpackhi_epi64(l, h);
+        r.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_castsi256_si128(rb));
+        b.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_extracti128_si256(rb, 1));
+        g.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_castsi256_si128(ga));
+        a.c[0] = (nvec<float, 8>)_mm256_cvtph_ps(_mm256_extracti128_si256(ga, 1));
+        return;
+    }
+#endif
+#if RTFACT_NATIVE_WIDTH >= 16 && defined(__AVX512BW__)
+    if constexpr (W == 16) {
+        using namespace simd;
+        const __m512i bytes = _mm512_set4_epi32(0x0f0e0706, 0x0d0c0504, 0x0b0a0302, 0x09080100);
+        const __m512i lo =
+            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 8);
+        const __m512i hi =
+            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx.c[0]), (const void*)base, 8);
+        // dword 4c + k of each: channel k of the entries 2c, 2c + 1
+        const __m512i l = _mm512_maskz_shuffle_epi8(~__mmask64(0), lo, bytes);
+        const __m512i h = _mm512_maskz_shuffle_epi8(~__mmask64(0), hi, bytes);
+        const __m512i rg = _mm512_permutex2var_epi32(
+            l, _mm512_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28, 1, 5, 9, 13, 17, 21, 25, 29), h);
+        const __m512i ba = _mm512_permutex2var_epi32(
+            l, _mm512_setr_epi32(2, 6, 10, 14, 18, 22, 26, 30, 3, 7, 11, 15, 19, 23, 27, 31), h);
+        const auto low = [](__m512i v) { return (__m256i)__builtin_shufflevector(v, v, 0, 1, 2, 3); };
+        const auto high = [](__m512i v) { return (__m256i)__builtin_shufflevector(v, v, 4, 5, 6, 7); };
+        r.c[0] = (nvec<float, 16>)_mm512_maskz_cvtph_ps(kAll16, low(rg));
+        g.c[0] = (nvec<float, 16>)_mm512_maskz_cvtph_ps(kAll16, high(rg));
+        b.c[0] = (nvec<float, 16>)_mm512_maskz_cvtph_ps(kAll16, low(ba));
+        a.c[0] = (nvec<float, 16>)_mm512_maskz_cvtph_ps(kAll16, high(ba));
+        return;
+    }
+#endif
+    for (int i = 0; i < W; ++i) {
+        const uint64_t e = base[idx[i]];
+        r[i] = fromHalf(uint16_t(e));
+        g[i] = fromHalf(uint16_t(e >> 16));
+        b[i] = fromHalf(uint16_t(e >> 32));
+        a[i] = fromHalf(uint16_t(e >> 48));
     }
 }
 
