@@ -218,8 +218,9 @@ BlockedWideBVH<Block, K> packLeafBlocks(WideBVHTopology<K>&& t, const Fill& fill
     const size_t n = out.order.size(), nn = out.nodes.size();
     if (n == 0) return out;
     // First block of each leaf, by the leaf's first element (leaves tile [0, n)); only
-    // leaf starts are written and read. On huge pages: every 4 KiB page of it is touched.
-    std::vector<uint32_t> first;
+    // leaf starts are written and read (uninitialised: no serial zeroing pass). On huge
+    // pages: every 4 KiB page of it is touched.
+    std::vector<uint32_t, UninitAllocator<uint32_t>> first;
     resizeHugePages(first, n);
     auto* nodes = out.nodes.data();
     tbb::parallel_for(size_t(0), nn, [&](size_t ni) {

@@ -8,10 +8,15 @@
 //
 // Speed: references are 32 bytes (min and max in two SSE halves, the id in the spare
 // lane); small ranges use few bins (the bin clear and sweep would dominate), large ones
-// alternate between two bin sets; the top levels bin and partition in parallel (private
-// bins merged; out-of-place block partition into a second buffer, which a one-thread
-// build neither needs nor allocates), and subtrees are built as parallel tasks. Scratch
-// nodes live on huge pages (page faults cost more than the binning on VMs).
+// alternate between two bin sets. With more than one thread the root node's ranges (and
+// below it only ranges too large for the subtree tasks to keep threads busy) bin in
+// parallel, one bin set per block of kGrain references, and partition out of place into
+// a second buffer in ONE pass: the blocks' bin counts say where each block's references
+// go (a one-thread build neither needs nor allocates that buffer). Every other range is
+// binned and partitioned serially in place inside parallel subtree tasks, which does the
+// same work with less memory traffic. The depth-first reorder of the nodes runs as
+// parallel tasks too (subtree sizes fix every position up front). Scratch nodes live on
+// huge pages (page faults cost more than the binning on VMs).
 #pragma once
 #include <immintrin.h>
 #include <tbb/blocked_range.h>
@@ -45,7 +50,8 @@ struct WideSAHBVHBuilder {
     static constexpr uint32_t kParallelSplit = 16384;  // parallel binning and partition above
     static constexpr uint32_t kParallelTasks = 1024;   // subtrees as tasks above
     static constexpr uint32_t kGrain = 4096;
-    static constexpr uint32_t kTwoBinSets = 256;  // ranges binned with two private bin sets
+    static constexpr uint32_t kTwoBinSets = 256;     // ranges binned with two private bin sets
+    static constexpr uint32_t kParallelPlace = 256;  // subtrees of this many nodes reordered as tasks
 
     template <int K>
     void build(std::span<const AABB> bounds, WideBVHTopology<K>& out) const;
@@ -74,14 +80,20 @@ struct WideSAHBVHBuilder {
         float cost = kInf;       // sum over both sides of half area x blocks
         __m128 cmin, scale;
         int bins = 0;
+        // Parallel ranges: the references of each kGrain block that go left, from the
+        // block's own bins (the partition then needs no counting pass).
+        std::vector<uint32_t> blockLeft;
     };
     // Per axis and bin: bounds (lo, hi) and count. Only the first n bins are set up (small
     // ranges use few bins: clearing all of them would cost more than binning).
     struct Bins {
         __m128 lo[3][kMaxBins], hi[3][kMaxBins];
         uint32_t count[3][kMaxBins];
-        int n;
-        explicit Bins(int nb) : n(nb) {
+        int n = 0;
+        Bins() {}  // NOLINT: unset, no zeroing (a slot that init() sets up later)
+        explicit Bins(int nb) { init(nb); }
+        void init(int nb) {
+            n = nb;
             const __m128 inf = _mm_set1_ps(kInf), ninf = _mm_set1_ps(-kInf);
             for (int a = 0; a < 3; ++a)
                 for (int k = 0; k < nb; ++k) {
@@ -107,8 +119,14 @@ struct WideSAHBVHBuilder {
     struct Ctx {
         Ref* buf[2];
         uint32_t* order;
-        void* nodes;             // WideBVHNode<K>*
-        uint32_t parallelSplit;  // ranges of this size on bin and partition in parallel
+        void* nodes;        // WideBVHNode<K>*
+        uint32_t* subtree;  // per node: inner nodes in its subtree, itself included
+        // Ranges of this size on bin and partition in parallel: while the root node is
+        // widened (nothing else runs then), and below it only ranges so large that the
+        // subtree tasks alone would leave threads idle (elsewhere the serial in-place
+        // pass does the same work with less memory traffic).
+        uint32_t parallelSplit;
+        uint32_t parallelSplitBelowRoot;
         std::atomic<uint32_t> next{0};
     };
 
@@ -152,7 +170,7 @@ struct WideSAHBVHBuilder {
         }
     }
 
-    Split findSplit(const Ctx& ctx, const Range& r) const {
+    Split findSplit(const Ctx& ctx, const Range& r, int depth) const {
         const Ref* refs = ctx.buf[r.buf];
         Split s;
         const uint32_t n = r.size();
@@ -165,17 +183,17 @@ struct WideSAHBVHBuilder {
         s.scale = _mm_load_ps(sc);
         s.cmin = _mm_setr_ps(cb.lo.x, cb.lo.y, cb.lo.z, 0.0f);
         Bins bins(s.bins);
-        if (n >= ctx.parallelSplit) {
-            bins = tbb::parallel_reduce(
-                tbb::blocked_range<uint32_t>(r.b, r.e, kGrain), Bins(s.bins),
-                [&](const tbb::blocked_range<uint32_t>& br, Bins acc) {
-                    binRange(refs, br.begin(), br.end(), s, acc);
-                    return acc;
-                },
-                [](Bins x, const Bins& y) {
-                    x.merge(y);
-                    return x;
-                });
+        // Parallel: bins per kGrain block (kept: their counts place each block's
+        // references in the partition), merged in block order.
+        std::vector<Bins> blockBins;
+        if (n >= (depth == 0 ? ctx.parallelSplit : ctx.parallelSplitBelowRoot)) {
+            blockBins.resize((n + kGrain - 1) / kGrain);
+            tbb::parallel_for(size_t(0), blockBins.size(), [&](size_t bi) {
+                const uint32_t b = r.b + uint32_t(bi) * kGrain;
+                blockBins[bi].init(s.bins);
+                binRange(refs, b, std::min(r.e, b + kGrain), s, blockBins[bi]);
+            });
+            for (const Bins& bb : blockBins) bins.merge(bb);
         } else {
             binRange(refs, r.b, r.e, s, bins);
         }
@@ -204,6 +222,14 @@ struct WideSAHBVHBuilder {
                 }
             }
         }
+        if (s.axis >= 0 && !blockBins.empty()) {
+            s.blockLeft.resize(blockBins.size());
+            for (size_t bi = 0; bi < blockBins.size(); ++bi) {
+                uint32_t c = 0;
+                for (int k = 0; k <= s.pos; ++k) c += blockBins[bi].count[s.axis][k];
+                s.blockLeft[bi] = c;
+            }
+        }
         return s;
     }
 
@@ -230,7 +256,7 @@ struct WideSAHBVHBuilder {
         const int a = s.axis, pos = s.pos, maxBin = s.bins - 1;
         const float sc = scl[a], cm = cmn[a];
         auto left = [=](const Ref& x) { return std::min(int((x.lo[a] + x.hi[a] - cm) * sc), maxBin) <= pos; };
-        if (n < ctx.parallelSplit) {
+        if (s.blockLeft.empty()) {
             // Local accumulators: the swaps may alias l and rr for the compiler, which
             // would then store them on every element.
             Box4 lb, lc, rb, rc;
@@ -252,48 +278,49 @@ struct WideSAHBVHBuilder {
             l.buf = rr.buf = r.buf;
             return;
         }
-        // Out of place in parallel: count per block, then scatter into the other buffer.
+        // Out of place in parallel, one pass: each kGrain block's left count came from its
+        // bins (findSplit), so every block knows where its references go. The side is
+        // taken from binOf, the very computation that binned them.
         Ref* dst = ctx.buf[1 - r.buf];
-        const uint32_t nb = (n + kGrain - 1) / kGrain;
-        struct BlockInfo {
-            uint32_t left;
-            Box4 lbox, lcbox, rbox, rcbox;
-        };
-        std::vector<BlockInfo> info(nb);
-        tbb::parallel_for(uint32_t(0), nb, [&](uint32_t bi) {
-            BlockInfo bl{};
-            bl.left = 0;
-            const uint32_t b = r.b + bi * kGrain, e = std::min(r.e, b + kGrain);
-            for (uint32_t i = b; i < e; ++i) {
-                if (left(src[i])) {
-                    ++bl.left;
-                    extend(bl.lbox, bl.lcbox, src[i]);
-                } else {
-                    extend(bl.rbox, bl.rcbox, src[i]);
-                }
-            }
-            info[bi] = bl;
-        });
-        uint32_t nl = 0;
+        const uint32_t nb = uint32_t(s.blockLeft.size());
         std::vector<uint32_t> lofs(nb), rofs(nb);
+        uint32_t nl = 0, nr = 0;
         for (uint32_t bi = 0; bi < nb; ++bi) {
             lofs[bi] = nl;
-            nl += info[bi].left;
-            l.box.extend(info[bi].lbox);
-            l.cbox.extend(info[bi].lcbox);
-            rr.box.extend(info[bi].rbox);
-            rr.cbox.extend(info[bi].rcbox);
-        }
-        uint32_t nr = 0;
-        for (uint32_t bi = 0; bi < nb; ++bi) {
             rofs[bi] = nr;
-            nr += std::min(kGrain, r.e - (r.b + bi * kGrain)) - info[bi].left;
+            nl += s.blockLeft[bi];
+            nr += std::min(kGrain, r.e - (r.b + bi * kGrain)) - s.blockLeft[bi];
         }
+        struct alignas(64) BlockBoxes {
+            Box4 lbox, lcbox, rbox, rcbox;
+        };
+        std::vector<BlockBoxes> boxes(nb);
+        const __m128i maxBinV = _mm_set1_epi32(maxBin);
         tbb::parallel_for(uint32_t(0), nb, [&](uint32_t bi) {
-            uint32_t li = r.b + lofs[bi], ri = r.b + nl + rofs[bi];
+            Box4 lb, lc, rb, rc;
+            Ref* ld = dst + r.b + lofs[bi];
+            Ref* rd = dst + r.b + nl + rofs[bi];
             const uint32_t b = r.b + bi * kGrain, e = std::min(r.e, b + kGrain);
-            for (uint32_t i = b; i < e; ++i) dst[left(src[i]) ? li++ : ri++] = src[i];
+            alignas(16) int32_t k[4];
+            for (uint32_t i = b; i < e; ++i) {
+                const Ref& x = src[i];
+                _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(x, s.cmin, s.scale, maxBinV));
+                if (k[a] <= pos) {
+                    extend(lb, lc, x);
+                    *ld++ = x;
+                } else {
+                    extend(rb, rc, x);
+                    *rd++ = x;
+                }
+            }
+            boxes[bi] = {lb, lc, rb, rc};
         });
+        for (const BlockBoxes& bb : boxes) {
+            l.box.extend(bb.lbox);
+            l.cbox.extend(bb.lcbox);
+            rr.box.extend(bb.rbox);
+            rr.cbox.extend(bb.rcbox);
+        }
         l.b = r.b, l.e = r.b + nl, rr.b = r.b + nl, rr.e = r.e;
         l.buf = rr.buf = 1 - r.buf;
     }
@@ -308,7 +335,7 @@ struct WideSAHBVHBuilder {
             return std::pair<int32_t, int32_t>(int32_t(r.b), int32_t(n));
         };
         if (n <= uint32_t(leafBlock) || depth >= kMaxDepth) return leaf();
-        Split s = findSplit(ctx, r);
+        Split s = findSplit(ctx, r, depth);
         const float area = r.box.halfArea();
         if (n <= uint32_t(maxLeafSize) && s.axis >= 0 &&
             intersectionCost * blocks(n) * area <= traversalCost * area + intersectionCost * s.cost)
@@ -329,7 +356,7 @@ struct WideSAHBVHBuilder {
             }
             if (best < 0) break;
             const Range c = kids[best];
-            const Split cs = findSplit(ctx, c);
+            const Split cs = findSplit(ctx, c, depth);
             partition(ctx, c, cs, kids[best], kids[cnt]);
             ++cnt;
         }
@@ -351,13 +378,48 @@ struct WideSAHBVHBuilder {
         } else {
             for (int i = 0; i < cnt; ++i) slot[i] = buildRange<K>(ctx, kids[i], depth + 1);
         }
+        uint32_t sub = 1;
         for (int i = 0; i < K; ++i) {
-            if (i < cnt)
+            if (i < cnt) {
                 node->set(i, kids[i].box.aabb(), slot[i].first, slot[i].second);
-            else
+                if (slot[i].second == 0) sub += ctx.subtree[slot[i].first];
+            } else {
                 node->clear(i);
+            }
         }
+        ctx.subtree[ni] = sub;
         return {int32_t(ni), 0};
+    }
+
+    // Copies the subtree of scratch node oi to out[ni] in depth-first order: a node's
+    // inner children next to each other from `free` on, then the first child's subtree,
+    // the second's, ... Subtree sizes give every position up front, so large subtrees
+    // are placed in parallel.
+    template <int K>
+    static void place(const WideBVHNode<K>* in, const uint32_t* subtree, WideBVHNode<K>* out, uint32_t oi, uint32_t ni,
+                      uint32_t free) {
+        WideBVHNode<K> d = in[oi];
+        uint32_t inner = 0;
+        for (int i = 0; i < K; ++i) inner += d.child[i] >= 0 && !d.isLeaf(i);
+        uint32_t kidOld[K], kidNew[K], kidFree[K], m = 0, next = free + inner;
+        for (int i = 0; i < K; ++i) {
+            if (d.child[i] < 0 || d.isLeaf(i)) continue;
+            kidOld[m] = uint32_t(d.child[i]);
+            kidNew[m] = free + m;
+            kidFree[m] = next;
+            next += subtree[kidOld[m]] - 1;
+            d.child[i] = int32_t(kidNew[m]);
+            ++m;
+        }
+        out[ni] = d;
+        if (subtree[oi] >= kParallelPlace) {
+            tbb::task_group g;
+            for (uint32_t j = 0; j < m; ++j)
+                g.run([=] { place<K>(in, subtree, out, kidOld[j], kidNew[j], kidFree[j]); });
+            g.wait();
+        } else {
+            for (uint32_t j = 0; j < m; ++j) place<K>(in, subtree, out, kidOld[j], kidNew[j], kidFree[j]);
+        }
     }
 };
 
@@ -401,12 +463,16 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
     // this upper bound cost nothing.
     std::vector<WideBVHNode<K>, UninitAllocator<WideBVHNode<K>>> nodes;
     resizeHugePages(nodes, std::max<uint32_t>(n, 1));
+    std::vector<uint32_t, UninitAllocator<uint32_t>> subtree;
+    resizeHugePages(subtree, std::max<uint32_t>(n, 1));
     Ctx ctx;
     ctx.buf[0] = refs[0].data();
     ctx.buf[1] = refs[1].data();
     ctx.parallelSplit = parallel ? kParallelSplit : std::numeric_limits<uint32_t>::max();
+    ctx.parallelSplitBelowRoot = parallel ? std::max(kParallelSplit, n / 4) : std::numeric_limits<uint32_t>::max();
     ctx.order = out.order.data();
     ctx.nodes = nodes.data();
+    ctx.subtree = subtree.data();
     Range r;
     r.b = 0, r.e = n, r.box = root.box, r.cbox = root.cbox;
     out.box = root.box.aabb();
@@ -420,23 +486,7 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
     }
     // Depth-first order (children after their parent) for locality; the root is node 0.
     resizeHugePages(out.nodes, ctx.next.load());
-    uint32_t used = 1;
-    std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, uint32_t(top.first)}};  // (new, old)
-    while (!stack.empty()) {
-        const auto [ni, oi] = stack.back();
-        stack.pop_back();
-        WideBVHNode<K>& dn = out.nodes[ni];
-        dn = nodes[oi];
-        // Siblings next to each other, the first child's subtree right after them.
-        for (int i = 0; i < K; ++i)
-            if (dn.child[i] >= 0 && !dn.isLeaf(i)) dn.child[i] = -2 - int32_t(used++);
-        for (int i = K - 1; i >= 0; --i)
-            if (dn.child[i] <= -2) {
-                const uint32_t nn = uint32_t(-2 - dn.child[i]);
-                stack.push_back({nn, uint32_t(nodes[oi].child[i])});
-                dn.child[i] = int32_t(nn);
-            }
-    }
+    place<K>(nodes.data(), subtree.data(), out.nodes.data(), uint32_t(top.first), 0, 1);
 }
 
 static_assert(Builder<WideSAHBVHBuilder, WideBVHTopology<4>>);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <functional>
 #include <random>
@@ -326,10 +327,10 @@ TEST(WideBVH, DirectStructureParallelTop) {
 // On one thread the builder partitions serially in place (no second reference buffer);
 // with more it partitions the top levels out of place in parallel. Both are valid trees
 // of the same shape: binning does not depend on the order within a range.
-TEST(WideBVH, DirectStructureOneThreadMatchesParallel) {
-    const auto s = testSpheres(70000);
+void expectOneThreadMatchesParallel(const std::vector<Sphere>& s) {
     tbb::task_arena one(1), two(2);
     one.execute([&] { checkDirectStructure<8>(s, 4); });
+    two.execute([&] { checkDirectStructure<8>(s, 4); });
     const std::vector<AABB> bounds = boundsOf(s);
     auto build = [&](tbb::task_arena& arena) {
         WideBVHTopology<8> w;
@@ -350,6 +351,65 @@ TEST(WideBVH, DirectStructureOneThreadMatchesParallel) {
     const auto [areaB, leavesB] = stats(b);
     EXPECT_EQ(leavesA, leavesB);
     EXPECT_NEAR(areaA, areaB, 1e-9 * areaB);
+    // The very same tree: node for node (the depth-first layout of the parallel reorder
+    // too), leaves over the same element ranges holding the same elements.
+    for (size_t ni = 0; ni < a.nodes.size(); ++ni)
+        for (int i = 0; i < 8; ++i) {
+            ASSERT_EQ(a.nodes[ni].child[i], b.nodes[ni].child[i]) << "node " << ni << " slot " << i;
+            ASSERT_EQ(a.nodes[ni].count[i], b.nodes[ni].count[i]) << "node " << ni << " slot " << i;
+            for (int ax = 0; ax < 3; ++ax) {
+                ASSERT_EQ(a.nodes[ni].lo[ax][i], b.nodes[ni].lo[ax][i]);
+                ASSERT_EQ(a.nodes[ni].hi[ax][i], b.nodes[ni].hi[ax][i]);
+            }
+            if (!a.nodes[ni].isLeaf(i)) continue;
+            const auto first = a.order.begin() + a.nodes[ni].child[i];
+            std::vector<uint32_t> ea(first, first + a.nodes[ni].count[i]);
+            std::vector<uint32_t> eb(b.order.begin() + b.nodes[ni].child[i],
+                                     b.order.begin() + b.nodes[ni].child[i] + b.nodes[ni].count[i]);
+            std::sort(ea.begin(), ea.end());
+            std::sort(eb.begin(), eb.end());
+            ASSERT_EQ(ea, eb) << "leaf " << ni << " slot " << i;
+        }
+}
+TEST(WideBVH, DirectStructureOneThreadMatchesParallel) { expectOneThreadMatchesParallel(testSpheres(70000)); }
+// Three quarters of the spheres in a tiny cluster in a corner: the first split cuts it
+// off and the root's widening never opens that small child, so ranges below the root
+// are large enough to bin and partition in parallel too.
+TEST(WideBVH, DirectStructureOneThreadMatchesParallelBelowRoot) {
+    std::vector<Sphere> s = testSpheres(20000);
+    for (Sphere x : testSpheres(60000)) s.push_back({x.center * 0.01f + Vec3f(0.9f), x.radius * 0.01f});
+    expectOneThreadMatchesParallel(s);
+}
+// Parallel subtree layout: children of a node sit next to each other and every node
+// comes after its parent, with the first child's subtree right after the siblings (the
+// serial depth-first order), for a tree deep enough to be reordered in parallel tasks.
+TEST(WideBVH, DirectLayoutDepthFirstInParallel) {
+    const auto s = testSpheres(200000);
+    const std::vector<AABB> bounds = boundsOf(s);
+    WideBVHTopology<4> w;
+    tbb::task_arena two(2);
+    two.execute([&] { WideSAHBVHBuilder{}.build(std::span<const AABB>(bounds), w); });
+    ASSERT_GT(w.nodes.size(), 1000u);
+    // Expected positions by the serial rule, from the root.
+    std::vector<uint32_t> expect(w.nodes.size(), 0);
+    uint32_t used = 1;
+    std::vector<uint32_t> stack{0};
+    size_t visited = 0;
+    while (!stack.empty()) {
+        const uint32_t ni = stack.back();
+        stack.pop_back();
+        ++visited;
+        std::vector<uint32_t> kids;
+        for (int i = 0; i < 4; ++i)
+            if (w.nodes[ni].child[i] >= 0 && !w.nodes[ni].isLeaf(i)) {
+                ASSERT_EQ(uint32_t(w.nodes[ni].child[i]), used++) << "child " << i << " of node " << ni;
+                kids.push_back(uint32_t(w.nodes[ni].child[i]));
+            }
+        for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(*it);
+    }
+    EXPECT_EQ(visited, w.nodes.size());
+    EXPECT_EQ(used, w.nodes.size());
+    checkTopology<4>(w, bounds, false);
 }
 // Coincident centroids (no SAH split exists): ranges are halved, leaves stay bounded.
 TEST(WideBVH, DirectStructureCoincident) {
