@@ -170,12 +170,18 @@ double timeRange(int threads, size_t n, size_t grain, F&& f) {
     });
 }
 
-// RTfact on the secondary ray list: packets of N through the packet BVH, or single rays
-// through the wide BVH. Results go to occ (AO) / t (bounce) for the agreement check.
+// How RTfact traces the secondary ray list: packets of N through the packet BVH, single
+// rays through the wide BVH (one call per ray), or packets of N through the wide BVH's
+// incoherent queries, which trace the lanes as interleaved single rays (as the AO and
+// path integrators call them).
+enum class SecondaryMode { Packet, WideSingle, WideGroup };
+
+// RTfact on the secondary ray list. Results go to occ (AO) / t (bounce) for the
+// agreement check.
 template <int N>
-void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr, size_t b, size_t e, bool wide, bool ao,
-                 std::vector<float>& out) {
-    if (wide) {
+void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr, size_t b, size_t e, SecondaryMode mode,
+                 bool ao, std::vector<float>& out) {
+    if (mode == SecondaryMode::WideSingle) {
         for (size_t i = b; i < e; ++i) {
             RayPacket<1> r;
             r.setLane(0, sr.org[i], sr.dir[i], 0.0f, ao ? sr.tMaxAO : kInfinity);
@@ -189,6 +195,7 @@ void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr,
         }
         return;
     }
+    const bool wide = mode == SecondaryMode::WideGroup;
     for (size_t p = b; p < e; p += N) {
         RayPacket<N> r;
         Mask<N> active(true);
@@ -201,10 +208,12 @@ void rtSecondary(const MeshScene<BVH<Triangle>>& scene, const SecondaryRays& sr,
         }
         r.finalize();
         if (ao) {
-            const Mask<N> occ = scene.template occluded<N>(r, active);
+            const Mask<N> occ =
+                wide ? scene.template occludedIncoherent<N>(r, active) : scene.template occluded<N>(r, active);
             for (int i = 0; i < N && p + size_t(i) < e; ++i) out[p + size_t(i)] = occ[i] ? 1.0f : 0.0f;
         } else {
-            const auto h = scene.template intersect<N>(r, active);
+            const auto h =
+                wide ? scene.template intersectIncoherent<N>(r, active) : scene.template intersect<N>(r, active);
             for (int i = 0; i < N && p + size_t(i) < e; ++i) out[p + size_t(i)] = h.id[i] >= 0 ? h.t[i] : kInfinity;
         }
     }
@@ -558,32 +567,37 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     if (secSamples > 0) {
         const SecondaryRays sr = makeSecondary(base, setup, scene.bounds(), secSamples, N);
         std::printf("secondary_rays=%zu (%d per primary hit, AO length %.4g)\n", sr.size(), secSamples, sr.tMaxAO);
-        std::vector<float> outP(sr.size()), outW(sr.size()), outE(sr.size());
+        std::vector<float> outP(sr.size()), outW(sr.size()), outG(sr.size()), outE(sr.size());
         double embreeMrays[2][2] = {{0, 0}, {0, 0}};  // [thread count index][ao]
         for (int ao = 1; ao >= 0; --ao) {
             const char* name = ao ? "ao_occluded" : "bounce_nearest";
             for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
                 const int T = threadCounts[ti];
-                Result p, wd, e;
+                Result p, wd, wg, e;
+                auto timeMode = [&](Result& res, const MeshScene<BVH<Triangle>>& sc, SecondaryMode m,
+                                    std::vector<float>& out) {
+                    res.ms = std::min(res.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
+                                          rtSecondary<N>(sc, sr, b, en, m, ao, out);
+                                      }));
+                };
                 for (int r = 0; r < repeat; ++r) {
-                    p.ms = std::min(p.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
-                                        rtSecondary<N>(pscene, sr, b, en, false, ao, outP);
-                                    }));
-                    wd.ms = std::min(wd.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
-                                         rtSecondary<N>(scene, sr, b, en, true, ao, outW);
-                                     }));
+                    timeMode(p, pscene, SecondaryMode::Packet, outP);
+                    timeMode(wd, scene, SecondaryMode::WideSingle, outW);
+                    timeMode(wg, scene, SecondaryMode::WideGroup, outG);
                     e.ms = std::min(e.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
                                         embreeSecondary(em->scene, sr, b, en, ao, outE);
                                     }));
                 }
-                p.rays = wd.rays = e.rays = sr.size();
+                p.rays = wd.rays = wg.rays = e.rays = sr.size();
                 embreeMrays[ti][ao] = e.mrays();
                 std::printf(
-                    "threads=%d %s_mrays: rtfact_wide_single=%.2f rtfact_packet%d=%.2f embree_single=%.2f "
-                    "ratio_wide_vs_embree=%.3f ratio_wide_vs_packet=%.3f\n",
-                    T, name, wd.mrays(), N, p.mrays(), e.mrays(), wd.mrays() / e.mrays(), wd.mrays() / p.mrays());
+                    "threads=%d %s_mrays: rtfact_wide_single=%.2f rtfact_wide_group=%.2f rtfact_packet%d=%.2f "
+                    "embree_single=%.2f ratio_wide_vs_embree=%.3f ratio_group_vs_embree=%.3f "
+                    "ratio_wide_vs_packet=%.3f\n",
+                    T, name, wd.mrays(), wg.mrays(), N, p.mrays(), e.mrays(), wd.mrays() / e.mrays(),
+                    wg.mrays() / e.mrays(), wd.mrays() / p.mrays());
             }
-            size_t diffPW = 0, diffWE = 0;
+            size_t diffPW = 0, diffWE = 0, diffWG = 0;
             for (size_t i = 0; i < sr.size(); ++i) {
                 const auto same = [&](float a, float b) {
                     return ao ? a == b
@@ -592,8 +606,10 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
                 };
                 diffPW += !same(outP[i], outW[i]);
                 diffWE += !same(outW[i], outE[i]);
+                diffWG += outW[i] != outG[i];  // the same traversal per ray: bit-exact
             }
-            std::printf("agreement_%s: packet_vs_wide_diff=%zu wide_vs_embree_diff=%zu\n", name, diffPW, diffWE);
+            std::printf("agreement_%s: packet_vs_wide_diff=%zu wide_vs_embree_diff=%zu wide_vs_group_diff=%zu\n", name,
+                        diffPW, diffWE, diffWG);
         }
         if (wideVariants) {
             wideVariant<8, 4>(mesh, sr, threadCounts, repeat, embreeMrays);

@@ -2,9 +2,11 @@
 // nested element intersector at the leaves (per element, per leaf or per SIMD block). One ray is tested against the K
 // child boxes of a node at once (one SIMD op per slab plane), the children hit are visited near to far and stack
 // entries keep their entry distance so they are skipped once a closer hit is known. Incoherent rays (AO, diffuse
-// bounces) gain nothing from packets; packets of N > 1 lanes are served by looping the single-ray path over the active
-// lanes, so an integrator picks at compile time which structure serves which rays.
+// bounces) gain nothing from packets; packets of N > 1 lanes are served by the single-ray path over the active
+// lanes (interleaved, several rays in flight, on trees larger than the caches), so an integrator picks at compile
+// time which structure serves which rays.
 #pragma once
+#include <algorithm>
 #include <concepts>
 #include <cstring>
 #include <type_traits>
@@ -41,34 +43,32 @@ struct WideBVHIntersector {
         } else {
             hit.t = rays.tMax;
             hit.id = Packet<N, int32_t>(-1);
-            BitMask<N>(active).forEach([&](int i) {
-                const RayPacket<1> r = rays.lane(i);
-                Hit<1> h;
-                h.t = r.tMax;
-                h.id = -1;
-                traverse<D, false>(bvh, r, h);
-                if (int32_t(h.id) >= 0) setHitLane(hit, i, h);
-            });
+            int lanes[N];
+            int count = 0;
+            BitMask<N>(active).forEach([&](int i) { lanes[count++] = i; });
+            traverseLanesFrom<D, false>(bvh, rays, hit, lanes, count, 0);
         }
     }
 
     template <bool CommonOrigin, class Tree, int N>
     Mask<N> occluded(const Tree& bvh, const RayPacket<N>& rays, const Mask<N>& active) const {
         Mask<N> occ(false);
-        BitMask<N>(active).forEach([&](int i) {
+        if constexpr (N == 1) {
             Hit<1> h;
-            if constexpr (N == 1) {
-                h.t = rays.tMax;
-                h.id = -1;
-                traverse<HitData::Distance, true>(bvh, rays, h);
-            } else {
-                const RayPacket<1> r = rays.lane(i);
-                h.t = r.tMax;
-                h.id = -1;
-                traverse<HitData::Distance, true>(bvh, r, h);
-            }
-            if (int32_t(h.id) >= 0) occ.set(i, true);
-        });
+            h.t = rays.tMax;
+            h.id = -1;
+            if (active[0]) traverse<HitData::Distance, true>(bvh, rays, h);
+            occ.set(0, int32_t(h.id) >= 0);
+        } else {
+            Hit<N> hit;
+            hit.t = rays.tMax;
+            hit.id = Packet<N, int32_t>(-1);
+            int lanes[N];
+            int count = 0;
+            BitMask<N>(active).forEach([&](int i) { lanes[count++] = i; });
+            traverseLanesFrom<HitData::Distance, true>(bvh, rays, hit, lanes, count, 0);
+            occ = active & (hit.id != Packet<N, int32_t>(-1));
+        }
         return occ;
     }
 
@@ -138,44 +138,61 @@ struct WideBVHIntersector {
         }
     }
 
-    // Closest hit: children hit are visited near to far (a single hit child is entered
-    // directly, more are insertion-sorted onto the stack) and a popped entry is skipped
-    // once a closer hit is known. Any hit: no ordering at all, larger children first
-    // (the builder's slot order). Every inner child entered or pushed is prefetched.
+    // One single-ray query as a resumable state: step() makes one node visit (the node
+    // test, its pushes, then pops and leaves up to the next inner node), so independent
+    // rays can be interleaved (traverseLanesFrom) and one ray's node load overlaps the work of
+    // the others. Closest hit: children hit are visited near to far (a single hit child
+    // is entered directly, more are insertion-sorted onto the stack) and a popped entry
+    // is skipped once a closer hit is known. Any hit: no ordering at all, larger children
+    // first (the builder's slot order). Every inner child entered or pushed is prefetched.
     template <HitData D, bool AnyHit, class Tree>
-    void traverse(const Tree& bvh, const RayPacket<1>& ray, Hit<1>& hit, int32_t root = 0) const {
-        if (bvh.nodes.empty()) return;
-        constexpr int K = Tree::arity;
+    struct Walk {
+        static constexpr int K = Tree::arity;
         using P = Packet<K>;
-        const WideBVHNode<K>* nodes = bvh.nodes.data();
-        // Near and far plane of each axis, by the sign of the direction, as offsets into
-        // the node's bounds (lo[3][K] then hi[3][K]): plain loads, no per-axis select.
-        int nearOff[3], farOff[3];
-        P org[3], inv[3];
-        for (int a = 0; a < 3; ++a) {
-            const float id = ray.invDir[a][0];
-            nearOff[a] = (id < 0.0f ? 3 * K : 0) + a * K;
-            farOff[a] = (id < 0.0f ? 0 : 3 * K) + a * K;
-            inv[a] = P(id);
-            org[a] = P(ray.org[a][0]);
-        }
-        const P tMin(float(ray.tMin));
         struct Entry {
             int32_t child, count;
             float dist;
         };
+        // Origin and reciprocal direction as scalars, broadcast at use (AVX-512 folds the
+        // broadcast into the arithmetic, and a group of walks stays small). The slabs keep
+        // the form (plane - org) * inv: a ray lying in a slab plane gets t = 0 there, where
+        // plane * inv - org * inv would give the rounding error of org * inv, of either sign.
+        float org[3], inv[3];
+        // Near and far plane of each axis, by the sign of the direction, as offsets into
+        // the node's bounds (lo[3][K] then hi[3][K]): plain loads, no per-axis select.
+        int nearOff[3], farOff[3];
+        float tMin;
+        int32_t node;
+        int sp;
         // Each wide level pushes at most K entries and pops one; wide trees are no deeper
         // than the binary ones they may come from, whose traversal assumes depth < 128.
         Entry stack[(K - 1) * 128 + 1];
-        int sp = 0;
-        int32_t node = root;
-        for (;;) {
+
+        RTFACT_INLINE void start(const Tree& bvh, const RayPacket<1>& ray, int32_t root) {
+            for (int a = 0; a < 3; ++a) {
+                const float id = ray.invDir[a][0];
+                nearOff[a] = (id < 0.0f ? 3 * K : 0) + a * K;
+                farOff[a] = (id < 0.0f ? 0 : 3 * K) + a * K;
+                inv[a] = id;
+                org[a] = float(ray.org[a][0]);
+            }
+            tMin = float(ray.tMin);
+            node = root;
+            sp = 0;
+            prefetchNode(bvh.nodes.data() + root);
+        }
+
+        // False once the query is done (hit holds the result).
+        RTFACT_INLINE bool step(const WideBVHIntersector& isect, const Tree& bvh, const RayPacket<1>& ray,
+                                Hit<1>& hit) {
+            const WideBVHNode<K>* nodes = bvh.nodes.data();
             const WideBVHNode<K>& n = nodes[node];
             const float* f = n.lo[0];
-            P tn = tMin, tf(float(hit.t));
+            P tn(tMin), tf(float(hit.t));
             for (int a = 0; a < 3; ++a) {
-                tn = max(tn, (P::load(f + nearOff[a]) - org[a]) * inv[a]);
-                tf = min(tf, (P::load(f + farOff[a]) - org[a]) * inv[a]);
+                const P o(org[a]), i(inv[a]);
+                tn = max(tn, (P::load(f + nearOff[a]) - o) * i);
+                tf = min(tf, (P::load(f + farOff[a]) - o) * i);
             }
             uint64_t bits = BitMask<K>(tn <= tf).w[0];
             if constexpr (!AnyHit) {
@@ -184,7 +201,7 @@ struct WideBVHIntersector {
                     if (!n.isLeaf(c)) {
                         node = n.child[c];
                         prefetchNode(nodes + node);
-                        continue;
+                        return true;
                     }
                 }
             }
@@ -218,16 +235,77 @@ struct WideBVHIntersector {
             }
             // Pop the nearest entry that can still hold a closer hit; run leaves.
             for (;;) {
-                if (sp == 0) return;
+                if (sp == 0) return false;
                 const Entry e = stack[--sp];
                 if constexpr (!AnyHit) {
                     if (!(e.dist <= float(hit.t))) continue;
                 }
                 if (e.count == 0) {
                     node = e.child;
-                    break;
+                    return true;
                 }
-                if (leaf<D, AnyHit>(bvh, e.child, e.count, ray, hit)) return;
+                if (isect.template leaf<D, AnyHit>(bvh, e.child, e.count, ray, hit)) return false;
+            }
+        }
+    };
+
+    template <HitData D, bool AnyHit, class Tree>
+    void traverse(const Tree& bvh, const RayPacket<1>& ray, Hit<1>& hit, int32_t root = 0) const {
+        if (bvh.nodes.empty()) return;
+        Walk<D, AnyHit, Tree> w;
+        w.start(bvh, ray, root);
+        while (w.step(*this, bvh, ray, hit)) {
+        }
+    }
+
+   public:
+    // Packet queries trace their lanes as independent single rays, `group` of them in
+    // flight at once (1..kMaxGroup): each advances one node visit in turn and a finished
+    // one hands its slot to the next lane, so one ray's cache misses overlap the others'
+    // work. That pays once the tree outgrows the caches; on a cache-resident tree the
+    // interleaving costs more than it hides (MeshScene picks by tree size). Every ray
+    // gets exactly the result of its own single-ray traversal.
+    static constexpr int kMaxGroup = 4;
+    int group = 1;
+
+    // Lanes lanes[0..count) of a packet as single rays from `root` (an inner node), each
+    // with hit.t[lane] as the distance to beat, `group` of them interleaved. A lane that
+    // finds a hit gets it in hit (any hit: its t becomes -inf, no box test passes any
+    // more); the others keep their hit record.
+    template <HitData D, bool AnyHit, class Tree, int N>
+    void traverseLanesFrom(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hitN, const int* lanes, int count,
+                           int32_t root) const {
+        if (bvh.nodes.empty()) return;
+        const int G = std::clamp(group, 1, kMaxGroup);
+        Walk<D, AnyHit, Tree> walk[kMaxGroup];
+        RayPacket<1> ray[kMaxGroup];
+        Hit<1> hit[kMaxGroup];
+        int laneOf[kMaxGroup], slot[kMaxGroup];
+        int next = 0, live = 0;
+        // Starts the next lane in walk w; false when none is left.
+        auto load = [&](int w) {
+            if (next == count) return false;
+            const int i = lanes[next++];
+            laneOf[w] = i;
+            ray[w] = rays.lane(i);
+            hit[w].t = hitN.t[i];
+            hit[w].id = -1;
+            walk[w].start(bvh, ray[w], root);
+            return true;
+        };
+        for (int w = 0; w < G && load(w); ++w) slot[live++] = w;
+        while (live > 0) {
+            for (int s = 0; s < live;) {
+                const int w = slot[s];
+                if (walk[w].step(*this, bvh, ray[w], hit[w])) {
+                    ++s;
+                    continue;
+                }
+                if (int32_t(hit[w].id) >= 0) {
+                    setHitLane(hitN, laneOf[w], hit[w]);
+                    if constexpr (AnyHit) hitN.t[laneOf[w]] = -kInfinity;
+                }
+                if (!load(w)) slot[s] = slot[--live];
             }
         }
     }

@@ -194,69 +194,75 @@ void checkTraversal(const std::vector<Elem>& elems, bool commonOrigin) {
     } else {
         using EI = decltype(elemIsect<Elem>());
         const auto w = makeTree<Elem, K, M>(elems);
-        const WideBVHIntersector<EI> isect;
-        std::mt19937 rng(N * 5 + K + commonOrigin);
-        std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f);
-        const int packets = std::max(4, 768 / N);
-        int hits = 0, occChecked = 0;
-        auto brute = [&](const RayPacket<1>& r) {
-            typename EI::template Hit<1> h;
-            h.t = r.tMax;
-            h.id = -1;
-            for (size_t i = 0; i < elems.size(); ++i)
-                EI{}.template intersect<HitData::Distance>(elems[i], uint32_t(i), r, h, 0);
-            return std::pair<float, int>{int32_t(h.id) >= 0 ? float(h.t) : kInfinity, int32_t(h.id)};
-        };
-        for (int p = 0; p < packets; ++p) {
-            RayPacket<N> rays;
-            const Vec3f eye{2.5f * u(rng), 1.5f + u01(rng), 2.5f * u(rng)};
-            for (int i = 0; i < N; ++i) {
-                const Vec3f o = commonOrigin ? eye : Vec3f{2.0f * u(rng), 2.0f * u(rng), 2.0f * u(rng)};
-                const Vec3f t = Vec3f{u(rng), u(rng), u(rng)} * 0.8f;
-                rays.setLane(i, o, normalize(t - o), 0.0f, kInfinity);
-            }
-            // Some axis-parallel directions exercise the nudged reciprocals.
-            if (p % 5 == 2) rays.setLane(0, Vec3f(0.1f, 3.0f, -0.2f), Vec3f(0, -1, 0), 0.0f, kInfinity);
-            rays.commonOrigin = commonOrigin && p % 5 != 2;
-            rays.finalize();
-            Mask<N> active(true);
-            if (p % 3 == 1)
-                for (int i = 0; i < N; ++i) active.set(i, u01(rng) < 0.6f);
-            typename EI::template Hit<N> hit;
-            if (rays.commonOrigin)
-                isect.template intersect<true, HitData::Shading>(w, rays, hit, active);
-            else
-                isect.template intersect<false, HitData::Shading>(w, rays, hit, active);
-            for (int i = 0; i < N; ++i) {
-                if (!active[i]) {
-                    EXPECT_EQ(hit.id[i], -1) << "inactive lane " << i << " reported a hit";
-                    continue;
+        // Packet queries trace their lanes one at a time or interleaved (group): both
+        // against brute force.
+        for (const int group : {1, 2, WideBVHIntersector<EI>::kMaxGroup}) {
+            SCOPED_TRACE(::testing::Message() << "group " << group);
+            WideBVHIntersector<EI> isect;
+            isect.group = group;
+            std::mt19937 rng(N * 5 + K + commonOrigin + 131 * group);
+            std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f);
+            const int packets = std::max(4, 768 / N);
+            int hits = 0, occChecked = 0;
+            auto brute = [&](const RayPacket<1>& r) {
+                typename EI::template Hit<1> h;
+                h.t = r.tMax;
+                h.id = -1;
+                for (size_t i = 0; i < elems.size(); ++i)
+                    EI{}.template intersect<HitData::Distance>(elems[i], uint32_t(i), r, h, 0);
+                return std::pair<float, int>{int32_t(h.id) >= 0 ? float(h.t) : kInfinity, int32_t(h.id)};
+            };
+            for (int p = 0; p < packets; ++p) {
+                RayPacket<N> rays;
+                const Vec3f eye{2.5f * u(rng), 1.5f + u01(rng), 2.5f * u(rng)};
+                for (int i = 0; i < N; ++i) {
+                    const Vec3f o = commonOrigin ? eye : Vec3f{2.0f * u(rng), 2.0f * u(rng), 2.0f * u(rng)};
+                    const Vec3f t = Vec3f{u(rng), u(rng), u(rng)} * 0.8f;
+                    rays.setLane(i, o, normalize(t - o), 0.0f, kInfinity);
                 }
-                const auto [bt, bid] = brute(rays.lane(i));
-                if (bid < 0) {
-                    EXPECT_EQ(hit.id[i], -1) << "packet " << p << " lane " << i;
-                    continue;
+                // Some axis-parallel directions exercise the nudged reciprocals.
+                if (p % 5 == 2) rays.setLane(0, Vec3f(0.1f, 3.0f, -0.2f), Vec3f(0, -1, 0), 0.0f, kInfinity);
+                rays.commonOrigin = commonOrigin && p % 5 != 2;
+                rays.finalize();
+                Mask<N> active(true);
+                if (p % 3 == 1)
+                    for (int i = 0; i < N; ++i) active.set(i, u01(rng) < 0.6f);
+                typename EI::template Hit<N> hit;
+                if (rays.commonOrigin)
+                    isect.template intersect<true, HitData::Shading>(w, rays, hit, active);
+                else
+                    isect.template intersect<false, HitData::Shading>(w, rays, hit, active);
+                for (int i = 0; i < N; ++i) {
+                    if (!active[i]) {
+                        EXPECT_EQ(hit.id[i], -1) << "inactive lane " << i << " reported a hit";
+                        continue;
+                    }
+                    const auto [bt, bid] = brute(rays.lane(i));
+                    if (bid < 0) {
+                        EXPECT_EQ(hit.id[i], -1) << "packet " << p << " lane " << i;
+                        continue;
+                    }
+                    ++hits;
+                    ASSERT_GE(hit.id[i], 0) << "packet " << p << " lane " << i << " missed (brute t=" << bt << ")";
+                    EXPECT_NEAR(hit.t[i], bt, 1e-5f * std::max(1.0f, bt));
                 }
-                ++hits;
-                ASSERT_GE(hit.id[i], 0) << "packet " << p << " lane " << i << " missed (brute t=" << bt << ")";
-                EXPECT_NEAR(hit.t[i], bt, 1e-5f * std::max(1.0f, bt));
-            }
-            RayPacket<N> seg = rays;
-            for (int i = 0; i < N; ++i) seg.tMax[i] = 3.0f * u01(rng);
-            const Mask<N> occ = isect.template occluded<false>(w, seg, active);
-            for (int i = 0; i < N; ++i) {
-                if (!active[i]) {
-                    EXPECT_FALSE(occ[i]);
-                    continue;
+                RayPacket<N> seg = rays;
+                for (int i = 0; i < N; ++i) seg.tMax[i] = 3.0f * u01(rng);
+                const Mask<N> occ = isect.template occluded<false>(w, seg, active);
+                for (int i = 0; i < N; ++i) {
+                    if (!active[i]) {
+                        EXPECT_FALSE(occ[i]);
+                        continue;
+                    }
+                    const auto [bt, bid] = brute(rays.lane(i));
+                    if (std::fabs(bt - seg.tMax[i]) < 1e-4f) continue;  // too close to call
+                    ++occChecked;
+                    EXPECT_EQ(occ[i], bt < seg.tMax[i]) << "packet " << p << " lane " << i;
                 }
-                const auto [bt, bid] = brute(rays.lane(i));
-                if (std::fabs(bt - seg.tMax[i]) < 1e-4f) continue;  // too close to call
-                ++occChecked;
-                EXPECT_EQ(occ[i], bt < seg.tMax[i]) << "packet " << p << " lane " << i;
             }
+            EXPECT_GT(hits, packets * N / 10);
+            EXPECT_GT(occChecked, packets * N / 2);
         }
-        EXPECT_GT(hits, packets * N / 10);
-        EXPECT_GT(occChecked, packets * N / 2);
     }
 }
 
@@ -466,6 +472,64 @@ RTFACT_WIDE_TESTS(Spheres, Sphere, testSpheres(2000), 8)
 RTFACT_WIDE_TESTS(Spheres, Sphere, testSpheres(2000), 4)
 RTFACT_WIDE_TESTS(Triangles, Triangle, testTriangles(), 8)
 RTFACT_WIDE_TESTS(Triangles, Triangle, testTriangles(), 16)
+
+// Interleaved lanes (group > 1) give every ray exactly its own single-ray result (t, id,
+// u, v bit for bit), nearest and any hit, also when fewer lanes than the group are
+// active and when lanes finish at different times.
+template <int K, int N>
+void checkGroupMatchesSingle() {
+    const auto t = testTriangles();
+    const auto w = makeTree<Triangle, K, Make::Blocks8>(t);
+    std::mt19937 rng(K + N);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.0f, 1.0f);
+    int hits = 0, occluded = 0;
+    for (int p = 0; p < 24; ++p) {
+        RayPacket<N> rays;
+        for (int i = 0; i < N; ++i) {
+            const Vec3f o{2.0f * u(rng), 2.0f * u(rng), 2.0f * u(rng)};
+            rays.setLane(i, o, normalize(Vec3f{u(rng), u(rng), u(rng)} * 0.8f - o), 0.0f,
+                         p % 2 ? kInfinity : 3.0f * u01(rng));
+        }
+        rays.finalize();
+        // Every lane, random 60%, exactly 1 and 3 lanes.
+        Mask<N> active(p % 4 == 0);
+        for (int i = 0; i < N; ++i)
+            if (p % 4 == 1) active.set(i, u01(rng) < 0.6f);
+        if (p % 4 == 2) active.set(N / 2, true);
+        if (p % 4 == 3) active.set(0, true), active.set(N - 1, true), active.set(N / 3, true);
+        for (const int group : {2, WideBVHIntersector<TriangleIntersector>::kMaxGroup}) {
+            WideBVHIntersector<TriangleIntersector> isect;
+            isect.group = group;
+            TriangleIntersector::Hit<N> hit;
+            isect.template intersect<false, HitData::Shading>(w, rays, hit, active);
+            const Mask<N> occ = isect.template occluded<false>(w, rays, active);
+            for (int i = 0; i < N; ++i) {
+                SCOPED_TRACE(::testing::Message() << "group " << group << " packet " << p << " lane " << i);
+                if (!active[i]) {
+                    EXPECT_EQ(hit.id[i], -1);
+                    EXPECT_FALSE(occ[i]);
+                    continue;
+                }
+                const RayPacket<1> r = rays.lane(i);
+                TriangleIntersector::Hit<1> h;
+                const WideBVHIntersector<TriangleIntersector> single;
+                single.intersect<false, HitData::Shading>(w, r, h, Mask<1>(true));
+                ASSERT_EQ(hit.id[i], int32_t(h.id));
+                EXPECT_EQ(occ[i], single.occluded<false>(w, r, Mask<1>(true))[0]);
+                occluded += occ[i];
+                if (int32_t(h.id) < 0) continue;
+                ++hits;
+                EXPECT_EQ(hit.t[i], float(h.t));
+                EXPECT_EQ(hit.u[i], float(h.u));
+                EXPECT_EQ(hit.v[i], float(h.v));
+            }
+        }
+    }
+    EXPECT_GT(hits, 100);
+    EXPECT_GT(occluded, 50);
+}
+TEST(WideBVH, GroupMatchesSingle8x64) { checkGroupMatchesSingle<8, 64>(); }
+TEST(WideBVH, GroupMatchesSingle16x256) { checkGroupMatchesSingle<16, 256>(); }
 
 // The mesh scene's incoherent queries (wide BVH, lane by lane) agree with its packet
 // queries on random rays from points on the surface.
