@@ -201,39 +201,17 @@ struct LoDWideIntersector {
     }
 
     // The packet chunk by chunk, its lanes regrouped so that each chunk is a compact tile
-    // of the image (the core's ChunkTiles order) when the packet has one. Inactive and
+    // of the image (the core's PacketChunkTiles order) when the packet has one. Inactive and
     // finished (any hit) lanes carry hit.t = -inf: no box test passes for them.
     template <bool CommonOrigin, HitData D, bool AnyHit, int N>
     void tracePacket(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
         if (bvh.nodes.empty()) return;
         hit.t = select(active, hit.t, Packet<N>(-kInfinity));
-        using T = typename WideBVHPacketIntersector<DiscBlockIntersector>::template ChunkTiles<N>;
         if constexpr (Packet<N>::W < 4) {
             BitMask<N>(active).forEach([&](int i) { singleLane<D, AnyHit>(bvh, rays, hit, i, 0); });
-        } else if constexpr (T::kEnabled) {
-            RayPacket<N> r;
-            Hit<N> h;
-            r.commonOrigin = rays.commonOrigin;
-            for (int i = 0; i < N; ++i) {
-                const int j = T::perm[size_t(i)];
-                for (int a = 0; a < 3; ++a) {
-                    r.org[a][i] = rays.org[a][j];
-                    r.dir[a][i] = rays.dir[a][j];
-                    r.invDir[a][i] = rays.invDir[a][j];
-                }
-                r.tMin[i] = rays.tMin[j];
-                r.tMax[i] = rays.tMax[j];
-                h.t[i] = hit.t[j];
-            }
-            h.id = Packet<N, int32_t>(-1);
-            traceChunks<CommonOrigin, D, AnyHit>(bvh, r, h);
-            for (int i = 0; i < N; ++i) {
-                const int j = T::perm[size_t(i)];
-                hit.t[j] = h.t[i];
-                hit.id[j] = h.id[i];
-            }
         } else {
-            traceChunks<CommonOrigin, D, AnyHit>(bvh, rays, hit);
+            traceInChunkTiles(
+                rays, hit, [&](const RayPacket<N>& r, Hit<N>& h) { traceChunks<CommonOrigin, D, AnyHit>(bvh, r, h); });
         }
     }
 

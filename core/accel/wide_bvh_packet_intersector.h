@@ -90,6 +90,73 @@ struct WideFrustum {
     }
 };
 
+// Lane order in which each native chunk of an N-ray packet is a compact tile of the
+// image. Packets from the renderer are bw x bh pixels in row-major order (bw the
+// smallest divisor of N with bw * bw >= N, core/render's packetBlockWidth), so W
+// consecutive lanes would be a thin strip (16 x 1 pixels for 256 rays on AVX-512);
+// cw x ch tiles cross fewer small nodes. Only speed depends on it: any packet is
+// traced correctly in any order. perm[i] is the packet lane that regrouped lane i holds.
+template <int N>
+struct PacketChunkTiles {
+    static constexpr int W = Packet<N>::W;
+    static constexpr int bw = [] {
+        for (int d = 1; d <= N; ++d)
+            if (N % d == 0 && d * d >= N) return d;
+        return N;
+    }();
+    static constexpr int bh = N / bw;
+    static constexpr int cw = W >= 8 ? 4 : 2, ch = W / cw;
+    static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % ch == 0;
+    static constexpr std::array<int16_t, N> perm = [] {
+        std::array<int16_t, N> p{};
+        const int tilesX = bw / cw;
+        for (int i = 0; i < N; ++i) {
+            const int tile = i / W, l = i % W;
+            const int x = (tile % tilesX) * cw + l % cw, y = (tile / tilesX) * ch + l / cw;
+            p[size_t(i)] = int16_t(y * bw + x);
+        }
+        return p;
+    }();
+};
+
+// Runs trace(r, h) on the packet regrouped in PacketChunkTiles order when the packet has
+// one (else on the packet as it is), then puts the hit records back in the packet's lane
+// order. h starts with hit.t and id -1.
+template <int N, class Hit, class Trace>
+void traceInChunkTiles(const RayPacket<N>& rays, Hit& hit, const Trace& trace) {
+    using T = PacketChunkTiles<N>;
+    if constexpr (T::kEnabled) {
+        RayPacket<N> r;
+        Hit h;
+        r.commonOrigin = rays.commonOrigin;
+        for (int i = 0; i < N; ++i) {
+            const int j = T::perm[size_t(i)];
+            for (int a = 0; a < 3; ++a) {
+                r.org[a][i] = rays.org[a][j];
+                r.dir[a][i] = rays.dir[a][j];
+                r.invDir[a][i] = rays.invDir[a][j];
+            }
+            r.tMin[i] = rays.tMin[j];
+            r.tMax[i] = rays.tMax[j];
+            h.t[i] = hit.t[j];
+        }
+        h.id = Packet<N, int32_t>(-1);
+        trace(r, h);
+        // Hit records are 4-byte lane packets (as WideBVHIntersector::setHitLane).
+        static_assert(sizeof(Hit) % (4 * N) == 0, "hit records must consist of 4-byte lane packets");
+        constexpr int kFields = int(sizeof(Hit) / (4 * N));
+        auto* d = reinterpret_cast<unsigned char*>(&hit);
+        const auto* src = reinterpret_cast<const unsigned char*>(&h);
+        for (int f = 0; f < kFields; ++f)
+            for (int i = 0; i < N; ++i)
+                std::memcpy(d + (size_t(f) * N + size_t(T::perm[size_t(i)])) * 4, src + (size_t(f) * N + size_t(i)) * 4,
+                            4);
+    } else {
+        hit.id = Packet<N, int32_t>(-1);
+        trace(rays, hit);
+    }
+}
+
 template <class ElemIsect>
 struct WideBVHPacketIntersector {
     ElemIsect elem{};
@@ -129,34 +196,8 @@ struct WideBVHPacketIntersector {
         }
     }
 
-    // Lane order in which each native chunk of an N-ray packet is a compact tile of the
-    // image. Packets from the renderer are bw x bh pixels in row-major order (bw the
-    // smallest divisor of N with bw * bw >= N, core/render's packetBlockWidth), so W
-    // consecutive lanes would be a thin strip (16 x 1 pixels for 256 rays on AVX-512);
-    // cw x ch tiles cross fewer small nodes. Only speed depends on it: any packet is
-    // traced correctly in any order. perm[i] is the packet lane that regrouped lane i holds.
     template <int N>
-    struct ChunkTiles {
-        static constexpr int W = Packet<N>::W;
-        static constexpr int bw = [] {
-            for (int d = 1; d <= N; ++d)
-                if (N % d == 0 && d * d >= N) return d;
-            return N;
-        }();
-        static constexpr int bh = N / bw;
-        static constexpr int cw = W >= 8 ? 4 : 2, ch = W / cw;
-        static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % ch == 0;
-        static constexpr std::array<int16_t, N> perm = [] {
-            std::array<int16_t, N> p{};
-            const int tilesX = bw / cw;
-            for (int i = 0; i < N; ++i) {
-                const int tile = i / W, l = i % W;
-                const int x = (tile % tilesX) * cw + l % cw, y = (tile / tilesX) * ch + l / cw;
-                p[size_t(i)] = int16_t(y * bw + x);
-            }
-            return p;
-        }();
-    };
+    using ChunkTiles = PacketChunkTiles<N>;
 
    private:
     // The active lanes chunk by chunk, in the tiled lane order when the packet has one.
@@ -164,36 +205,8 @@ struct WideBVHPacketIntersector {
     void traversePacket(const Tree& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
         hit.t = select(active, rays.tMax, Packet<N>(-kInfinity));
         hit.id = Packet<N, int32_t>(-1);
-        using T = ChunkTiles<N>;
-        if constexpr (T::kEnabled) {
-            RayPacket<N> r;
-            Hit<N> h;
-            r.commonOrigin = rays.commonOrigin;
-            for (int i = 0; i < N; ++i) {
-                const int j = T::perm[size_t(i)];
-                for (int a = 0; a < 3; ++a) {
-                    r.org[a][i] = rays.org[a][j];
-                    r.dir[a][i] = rays.dir[a][j];
-                    r.invDir[a][i] = rays.invDir[a][j];
-                }
-                r.tMin[i] = rays.tMin[j];
-                r.tMax[i] = rays.tMax[j];
-                h.t[i] = hit.t[j];
-            }
-            h.id = Packet<N, int32_t>(-1);
-            traverseChunks<CommonOrigin, D, AnyHit>(bvh, r, h);
-            // Hit records are 4-byte lane packets (as WideBVHIntersector::setHitLane).
-            static_assert(sizeof(Hit<N>) % (4 * N) == 0, "hit records must consist of 4-byte lane packets");
-            constexpr int kFields = int(sizeof(Hit<N>) / (4 * N));
-            auto* d = reinterpret_cast<unsigned char*>(&hit);
-            const auto* src = reinterpret_cast<const unsigned char*>(&h);
-            for (int f = 0; f < kFields; ++f)
-                for (int i = 0; i < N; ++i)
-                    std::memcpy(d + (size_t(f) * N + size_t(T::perm[size_t(i)])) * 4,
-                                src + (size_t(f) * N + size_t(i)) * 4, 4);
-        } else {
-            traverseChunks<CommonOrigin, D, AnyHit>(bvh, rays, hit);
-        }
+        traceInChunkTiles(
+            rays, hit, [&](const RayPacket<N>& r, Hit<N>& h) { traverseChunks<CommonOrigin, D, AnyHit>(bvh, r, h); });
     }
     // Lanes with hit.t > -inf are active.
     template <bool CommonOrigin, HitData D, bool AnyHit, class Tree, int N>
