@@ -187,42 +187,6 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
     }
 }
 
-// Two adjacent floats per lane from base[2 * idx] (for interleaved tables): 64-bit
-// gathers on AVX-512 (half the gathered elements of two 32-bit gathers).
-template <int W>
-RTFACT_INLINE void fetchFloatPair(const float* base, const Packet<W, int32_t>& idx2, Packet<W>& a, Packet<W>& b) {
-    if constexpr (Packet<W>::C > 1) {
-        for (int k = 0; k < Packet<W>::C; ++k)
-            fetchFloatPair<Packet<W>::W>(base, idx2.chunk(k), a.chunk(k), b.chunk(k));
-        return;
-    }
-#if RTFACT_NATIVE_WIDTH == 8
-    if constexpr (W == 8) {
-        const __m256 lo = _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, lowHalf8(idx2.c[0]), 8));
-        const __m256 hi = _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, highHalf8(idx2.c[0]), 8));
-        splitPairs8(lo, hi, a.c[0], b.c[0]);
-        return;
-    }
-#endif
-#if RTFACT_NATIVE_WIDTH >= 16
-    if constexpr (W == 16) {
-        const __m512 lo = _mm512_castsi512_ps(
-            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx2.c[0]), (const void*)base, 8));
-        const __m512 hi = _mm512_castsi512_ps(
-            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx2.c[0]), (const void*)base, 8));
-        const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-        const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
-        a.c[0] = (simd::nvec<float, 16>)_mm512_permutex2var_ps(lo, even, hi);
-        b.c[0] = (simd::nvec<float, 16>)_mm512_permutex2var_ps(lo, odd, hi);
-        return;
-    }
-#endif
-    for (int i = 0; i < W; ++i) {
-        a[i] = base[2 * idx2[i]];
-        b[i] = base[2 * idx2[i] + 1];
-    }
-}
-
 // One transfer-function entry per lane: r, g, b, a as four halves in 64 bits (half_float.h)
 // at base[idx], one 64-bit gather per lane; the halves are sorted by channel with byte and
 // dword shuffles, then converted with F16C.

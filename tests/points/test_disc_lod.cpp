@@ -536,6 +536,40 @@ std::vector<std::vector<uint32_t>> wideSlotsOfDiscs(const LoDWideBVH& w) {
     return slots;
 }
 
+// Camera rays through pixels [first, first + N) of the 32 x 32 image; with distinct
+// origins, moved along the rays (distinct, same footprints roughly).
+template <int N>
+RayPacket<N> cameraPacket(const PinholeCamera& cam, int first, bool commonOrigin, std::mt19937& g) {
+    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+    Packet<N> px, py;
+    for (int i = 0; i < N; ++i) px[i] = float((first + i) % 32) + 0.5f, py[i] = float((first + i) / 32 % 32) + 0.5f;
+    RayPacket<N> rays;
+    cam.generate<N>(px, py, rays);
+    if (!commonOrigin) {
+        for (int i = 0; i < N; ++i)
+            rays.setLane(i, rays.org.lane(i) + rays.dir.lane(i) * (0.3f + u(g)), rays.dir.lane(i), 0.0f, kInfinity);
+        rays.commonOrigin = false;
+        rays.finalize();
+    }
+    return rays;
+}
+
+// n discs of radius r on the unit sphere, facing outwards, in a wide BVH.
+PointScene wideSphere(int n, uint32_t seed, float r, LoDWideSplit split) {
+    std::vector<Disc> sphere = randomDiscs(n, seed);
+    std::mt19937 g(seed + 1);
+    for (Disc& d : sphere) {
+        d.center = randomUnit(g);
+        d.normal = encodeNormal(d.center);
+        d.radius = r;
+    }
+    PointScene scene;
+    scene.accel = PointAccel::Wide;
+    scene.wideSplit = split;
+    scene.build(sphere);
+    return scene;
+}
+
 // At a coarse quality, lane by lane through packets of N: nearest and any hit agree
 // (the cut does not depend on the hit so far), representatives are hit on their scaled
 // discs, and within (1 + repScale) R of full detail where that hits their subtree.
@@ -546,20 +580,10 @@ RepHitStats checkWideRepresentativeHits(const PointScene& scene, bool commonOrig
     const float repScale = 0.7f;
     const PinholeCamera cam(fitCamera(scene.bounds(), 45.0f, 1.0f), 32, 32);
     std::mt19937 g(seed);
-    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
     RepHitStats st;
     PointScene& sc = const_cast<PointScene&>(scene);
     for (int first = 0; first < 1024; first += N) {
-        Packet<N> px, py;
-        for (int i = 0; i < N; ++i) px[i] = float((first + i) % 32) + 0.5f, py[i] = float((first + i) / 32 % 32) + 0.5f;
-        RayPacket<N> rays;
-        cam.generate<N>(px, py, rays);
-        if (!commonOrigin) {  // origins moved along the rays: distinct, same footprints roughly
-            for (int i = 0; i < N; ++i)
-                rays.setLane(i, rays.org.lane(i) + rays.dir.lane(i) * (0.3f + u(g)), rays.dir.lane(i), 0.0f, kInfinity);
-            rays.commonOrigin = false;
-            rays.finalize();
-        }
+        const RayPacket<N> rays = cameraPacket<N>(cam, first, commonOrigin, g);
         Mask<N> active(true);
         for (int i = 5; i < N; i += 9) active.set(i, false);
         sc.setLoD(cam.cone(), 8.0f, repScale);
@@ -654,17 +678,7 @@ TEST_P(DiscWideBVHSplit, CoarseQualityAnswersWithRepresentatives) {
     vol.accel = PointAccel::Wide;
     vol.wideSplit = GetParam();
     vol.build(randomDiscs(4000, 41));
-    std::vector<Disc> sphere = randomDiscs(4000, 42);
-    std::mt19937 g(43);
-    for (Disc& d : sphere) {
-        d.center = randomUnit(g);
-        d.normal = encodeNormal(d.center);
-        d.radius = 0.06f;
-    }
-    PointScene surf;
-    surf.accel = PointAccel::Wide;
-    surf.wideSplit = GetParam();
-    surf.build(sphere);
+    PointScene surf = wideSphere(4000, 42, 0.06f, GetParam());
     for (bool common : {true, false}) {
         SCOPED_TRACE(common);
         const RepHitStats a = checkWideRepresentativeHits<1>(vol, common, 61);
@@ -697,18 +711,8 @@ void checkPacketsAsSingleRays(PointScene& scene, float quality, bool commonOrigi
     const PinholeCamera cam(fitCamera(scene.bounds(), 45.0f, 1.0f), 32, 32);
     scene.setLoD(cam.cone(), quality);
     std::mt19937 g(seed);
-    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
     for (int first = 0; first < 32 * 32; first += N) {
-        Packet<N> px, py;
-        for (int i = 0; i < N; ++i) px[i] = float((first + i) % 32) + 0.5f, py[i] = float((first + i) / 32 % 32) + 0.5f;
-        RayPacket<N> rays;
-        cam.generate<N>(px, py, rays);
-        if (!commonOrigin) {
-            for (int i = 0; i < N; ++i)
-                rays.setLane(i, rays.org.lane(i) + rays.dir.lane(i) * (0.3f + u(g)), rays.dir.lane(i), 0.0f, kInfinity);
-            rays.commonOrigin = false;
-            rays.finalize();
-        }
+        const RayPacket<N> rays = cameraPacket<N>(cam, first, commonOrigin, g);
         Mask<N> active(true);
         for (int i = 3; i < N; i += 7) active.set(i, false);
         const auto hit = scene.intersect<N>(rays, active);
@@ -737,17 +741,7 @@ void checkPacketsAsSingleRays(PointScene& scene, float quality, bool commonOrigi
 }
 
 TEST_P(DiscWideBVHSplit, PacketsAnswerAsSingleRays) {
-    std::vector<Disc> sphere = randomDiscs(20000, 71);
-    std::mt19937 g(72);
-    for (Disc& d : sphere) {
-        d.center = randomUnit(g);
-        d.normal = encodeNormal(d.center);
-        d.radius = 0.03f;
-    }
-    PointScene scene;
-    scene.accel = PointAccel::Wide;
-    scene.wideSplit = GetParam();
-    scene.build(sphere);
+    PointScene scene = wideSphere(20000, 71, 0.03f, GetParam());
     for (float q : {0.0f, 4.0f, 16.0f}) {
         SCOPED_TRACE(q);
         PacketVsSingle st;
