@@ -10,13 +10,13 @@
 // lane); small ranges use few bins (the bin clear and sweep would dominate), large ones
 // alternate between two bin sets. With more than one thread the root node's ranges (and
 // below it only ranges too large for the subtree tasks to keep threads busy) bin in
-// parallel, one bin set per block of kGrain references, and partition out of place into
-// a second buffer in ONE pass: the blocks' bin counts say where each block's references
-// go (a one-thread build neither needs nor allocates that buffer). Every other range is
-// binned and partitioned serially in place inside parallel subtree tasks, which does the
-// same work with less memory traffic. The depth-first reorder of the nodes runs as
-// parallel tasks too (subtree sizes fix every position up front). Scratch nodes live on
-// huge pages (page faults cost more than the binning on VMs).
+// parallel, one bin set per block of kGrain references, and partition in place in
+// parallel (partitionParallel: no second reference buffer, whose first-touch page faults
+// cost more than the pass it saved). Every other range is binned and partitioned
+// serially in place inside parallel subtree tasks. The depth-first reorder of the nodes
+// runs as parallel tasks too (subtree sizes fix every position up front). Scratch nodes
+// live on huge pages (page faults cost more than the binning on VMs), and the element
+// bounds can come from a function (no bounds array to fill and fault in first).
 #pragma once
 #include <immintrin.h>
 #include <tbb/blocked_range.h>
@@ -31,6 +31,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "core/accel/box4.h"
@@ -55,6 +56,11 @@ struct WideSAHBVHBuilder {
 
     template <int K>
     void build(std::span<const AABB> bounds, WideBVHTopology<K>& out) const;
+    // The same from n elements' bounds computed on the fly (boundsOf(i) returns element
+    // i's AABB): no bounds array to fill and fault in first.
+    template <int K, class BoundsOf>
+    requires std::is_invocable_r_v<AABB, const BoundsOf&, uint32_t>
+    void build(uint32_t n, const BoundsOf& boundsOf, WideBVHTopology<K>& out) const;
 
    private:
     struct alignas(16) Ref {
@@ -67,11 +73,9 @@ struct WideSAHBVHBuilder {
         box.extend(l, h);
         cbox.extend(c, c);
     }
-    // A range of references, in buffer `buf` (0 or 1), with its bounds and the bounds of
-    // its doubled centroids.
+    // A range of references with its bounds and the bounds of its doubled centroids.
     struct Range {
         uint32_t b = 0, e = 0;
-        int buf = 0;
         Box4 box, cbox;
         uint32_t size() const { return e - b; }
     };
@@ -116,18 +120,30 @@ struct WideSAHBVHBuilder {
                 }
         }
     };
+    // The scratch tree: per node its children's records (only the used slots: wide nodes
+    // are far from full, so this touches less fresh memory than whole nodes would).
+    struct ScratchKid {
+        float lo[3], hi[3];    // the child's box (plain floats: no initialiser runs on allocation)
+        int32_t child, count;  // as WideBVHNode's child and count
+        AABB box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+    };
+    struct ScratchNode {
+        uint32_t first;    // first record in ScratchKid[]
+        uint32_t kids;     // records
+        uint32_t subtree;  // inner nodes in its subtree, itself included
+    };
     struct Ctx {
-        Ref* buf[2];
+        Ref* refs;
         uint32_t* order;
-        void* nodes;        // WideBVHNode<K>*
-        uint32_t* subtree;  // per node: inner nodes in its subtree, itself included
+        ScratchNode* nodes;
+        ScratchKid* kids;
         // Ranges of this size on bin and partition in parallel: while the root node is
         // widened (nothing else runs then), and below it only ranges so large that the
         // subtree tasks alone would leave threads idle (elsewhere the serial in-place
         // pass does the same work with less memory traffic).
         uint32_t parallelSplit;
         uint32_t parallelSplitBelowRoot;
-        std::atomic<uint32_t> next{0};
+        std::atomic<uint32_t> next{0}, nextKid{0};
     };
 
     static constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -171,7 +187,7 @@ struct WideSAHBVHBuilder {
     }
 
     Split findSplit(const Ctx& ctx, const Range& r, int depth) const {
-        const Ref* refs = ctx.buf[r.buf];
+        const Ref* refs = ctx.refs;
         Split s;
         const uint32_t n = r.size();
         const AABB cb = r.cbox.aabb();
@@ -235,7 +251,7 @@ struct WideSAHBVHBuilder {
 
     // Splits r into l and rr (the references move to the children's buffers).
     void partition(Ctx& ctx, const Range& r, const Split& s, Range& l, Range& rr) const {
-        Ref* src = ctx.buf[r.buf];
+        Ref* src = ctx.refs;
         l = Range{};
         rr = Range{};
         const uint32_t n = r.size();
@@ -247,7 +263,6 @@ struct WideSAHBVHBuilder {
                 extend(d.box, d.cbox, src[i]);
             }
             l.b = r.b, l.e = mid, rr.b = mid, rr.e = r.e;
-            l.buf = rr.buf = r.buf;
             return;
         }
         alignas(16) float scl[4], cmn[4];
@@ -275,43 +290,49 @@ struct WideSAHBVHBuilder {
             }
             l.box = lb, l.cbox = lc, rr.box = rb, rr.cbox = rc;
             l.b = r.b, l.e = i, rr.b = i, rr.e = r.e;
-            l.buf = rr.buf = r.buf;
             return;
         }
-        // Out of place in parallel, one pass: each kGrain block's left count came from its
-        // bins (findSplit), so every block knows where its references go. The side is
-        // taken from binOf, the very computation that binned them.
-        Ref* dst = ctx.buf[1 - r.buf];
-        const uint32_t nb = uint32_t(s.blockLeft.size());
-        std::vector<uint32_t> lofs(nb), rofs(nb);
-        uint32_t nl = 0, nr = 0;
-        for (uint32_t bi = 0; bi < nb; ++bi) {
-            lofs[bi] = nl;
-            rofs[bi] = nr;
-            nl += s.blockLeft[bi];
-            nr += std::min(kGrain, r.e - (r.b + bi * kGrain)) - s.blockLeft[bi];
-        }
+        partitionParallel(ctx, r, s, l, rr);
+    }
+
+    // In place in parallel, in two passes over kGrain blocks and no second buffer (its
+    // first touch cost more than the pass it saved). Pass 1 marks each reference's side
+    // in a bit array and gathers both children's bounds; each block's left count came
+    // from its bins (findSplit), so the left child is [b, b + nl). Pass 2 swaps the
+    // misplaced pairs: the k-th right reference inside [b, b + nl) with the k-th left one
+    // beyond it, each task a chunk of the left part and its matching misplaced lefts.
+    void partitionParallel(Ctx& ctx, const Range& r, const Split& s, Range& l, Range& rr) const {
+        Ref* src = ctx.refs;
+        const uint32_t n = r.size(), nb = uint32_t(s.blockLeft.size());
+        uint32_t nl = 0;
+        for (uint32_t c : s.blockLeft) nl += c;
+        static_assert(kGrain % 64 == 0, "blocks own whole words of the side bits");
+        std::vector<uint64_t, UninitAllocator<uint64_t>> side((n + 63) / 64);  // bit set: goes left
         struct alignas(64) BlockBoxes {
             Box4 lbox, lcbox, rbox, rcbox;
         };
         std::vector<BlockBoxes> boxes(nb);
-        const __m128i maxBinV = _mm_set1_epi32(maxBin);
+        const int a = s.axis, pos = s.pos;
+        const __m128i maxBinV = _mm_set1_epi32(s.bins - 1);
         tbb::parallel_for(uint32_t(0), nb, [&](uint32_t bi) {
             Box4 lb, lc, rb, rc;
-            Ref* ld = dst + r.b + lofs[bi];
-            Ref* rd = dst + r.b + nl + rofs[bi];
-            const uint32_t b = r.b + bi * kGrain, e = std::min(r.e, b + kGrain);
+            const uint32_t b = bi * kGrain, e = std::min(n, b + kGrain);
             alignas(16) int32_t k[4];
-            for (uint32_t i = b; i < e; ++i) {
-                const Ref& x = src[i];
-                _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(x, s.cmin, s.scale, maxBinV));
-                if (k[a] <= pos) {
-                    extend(lb, lc, x);
-                    *ld++ = x;
-                } else {
-                    extend(rb, rc, x);
-                    *rd++ = x;
+            for (uint32_t w = b; w < e; w += 64) {
+                uint64_t bits = 0;
+                const uint32_t we = std::min(e, w + 64);
+                for (uint32_t i = w; i < we; ++i) {
+                    const Ref& x = src[r.b + i];
+                    // The side from binOf, the very computation that binned it.
+                    _mm_store_si128(reinterpret_cast<__m128i*>(k), binOf(x, s.cmin, s.scale, maxBinV));
+                    if (k[a] <= pos) {
+                        extend(lb, lc, x);
+                        bits |= uint64_t(1) << (i - w);
+                    } else {
+                        extend(rb, rc, x);
+                    }
                 }
+                side[w / 64] = bits;
             }
             boxes[bi] = {lb, lc, rb, rc};
         });
@@ -322,7 +343,54 @@ struct WideSAHBVHBuilder {
             rr.cbox.extend(bb.rcbox);
         }
         l.b = r.b, l.e = r.b + nl, rr.b = r.b + nl, rr.e = r.e;
-        l.buf = rr.buf = 1 - r.buf;
+        // Bits equal to `want` in [from, to) (positions relative to r.b).
+        auto count = [&](uint32_t from, uint32_t to, bool want) {
+            uint32_t c = 0;
+            for (uint32_t p = from; p < to;) {
+                const uint32_t wi = p / 64, lo = p % 64, hi = std::min<uint32_t>(64, to - wi * 64);
+                uint64_t w = want ? side[wi] : ~side[wi];
+                w >>= lo;
+                if (hi - lo < 64) w &= (uint64_t(1) << (hi - lo)) - 1;
+                c += uint32_t(__builtin_popcountll(w));
+                p = wi * 64 + hi;
+            }
+            return c;
+        };
+        // First position >= p whose bit equals `want` (one exists).
+        auto next = [&](uint32_t p, bool want) {
+            uint32_t wi = p / 64;
+            uint64_t w = (want ? side[wi] : ~side[wi]) & (~uint64_t(0) << (p % 64));
+            while (!w) w = want ? side[++wi] : ~side[++wi];
+            return wi * 64 + uint32_t(__builtin_ctzll(w));
+        };
+        const uint32_t nlc = (nl + kGrain - 1) / kGrain, nrc = (n - nl + kGrain - 1) / kGrain;
+        std::vector<uint32_t> lpre(nlc + 1, 0), rpre(nrc + 1, 0);
+        for (uint32_t c = 0; c < nlc; ++c)
+            lpre[c + 1] = lpre[c] + count(c * kGrain, std::min(nl, (c + 1) * kGrain), false);
+        for (uint32_t c = 0; c < nrc; ++c)
+            rpre[c + 1] = rpre[c] + count(nl + c * kGrain, std::min(n, nl + (c + 1) * kGrain), true);
+        tbb::parallel_for(uint32_t(0), nlc, [&](uint32_t c) {
+            const uint32_t m = lpre[c + 1] - lpre[c];
+            if (m == 0) return;
+            // The lpre[c]-th misplaced left: its chunk from rpre, then skip within it.
+            const uint32_t rc = uint32_t(std::upper_bound(rpre.begin(), rpre.end(), lpre[c]) - rpre.begin()) - 1;
+            uint32_t skip = lpre[c] - rpre[rc], j = nl + rc * kGrain;
+            uint32_t wi = j / 64;
+            uint64_t w = side[wi] & (~uint64_t(0) << (j % 64));
+            for (uint32_t pc; (pc = uint32_t(__builtin_popcountll(w))) <= skip;) {
+                skip -= pc;
+                w = side[++wi];
+            }
+            for (; skip > 0; --skip) w &= w - 1;
+            j = wi * 64 + uint32_t(__builtin_ctzll(w));
+            uint32_t i = c * kGrain;
+            for (uint32_t k = 0; k < m; ++k) {
+                i = next(i, false);
+                j = next(j, true);
+                std::swap(src[r.b + i], src[r.b + j]);
+                ++i, ++j;
+            }
+        });
     }
 
     // Returns the child slot (node index, 0) or (first element, count) for range r.
@@ -330,7 +398,7 @@ struct WideSAHBVHBuilder {
     std::pair<int32_t, int32_t> buildRange(Ctx& ctx, const Range& r, int depth) const {
         const uint32_t n = r.size();
         auto leaf = [&] {
-            const Ref* src = ctx.buf[r.buf];
+            const Ref* src = ctx.refs;
             for (uint32_t i = r.b; i < r.e; ++i) std::memcpy(&ctx.order[i], &src[i].lo[3], 4);
             return std::pair<int32_t, int32_t>(int32_t(r.b), int32_t(n));
         };
@@ -369,7 +437,6 @@ struct WideSAHBVHBuilder {
                 std::swap(kids[j - 1], kids[j]);
             }
         const uint32_t ni = ctx.next.fetch_add(1, std::memory_order_relaxed);
-        auto* node = static_cast<WideBVHNode<K>*>(ctx.nodes) + ni;
         std::pair<int32_t, int32_t> slot[K];
         if (n >= kParallelTasks) {
             tbb::task_group g;
@@ -378,16 +445,15 @@ struct WideSAHBVHBuilder {
         } else {
             for (int i = 0; i < cnt; ++i) slot[i] = buildRange<K>(ctx, kids[i], depth + 1);
         }
+        const uint32_t first = ctx.nextKid.fetch_add(uint32_t(cnt), std::memory_order_relaxed);
         uint32_t sub = 1;
-        for (int i = 0; i < K; ++i) {
-            if (i < cnt) {
-                node->set(i, kids[i].box.aabb(), slot[i].first, slot[i].second);
-                if (slot[i].second == 0) sub += ctx.subtree[slot[i].first];
-            } else {
-                node->clear(i);
-            }
+        for (int i = 0; i < cnt; ++i) {
+            const AABB b = kids[i].box.aabb();
+            ctx.kids[first + uint32_t(i)] = {
+                {b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}, slot[i].first, slot[i].second};
+            if (slot[i].second == 0) sub += ctx.nodes[slot[i].first].subtree;
         }
-        ctx.subtree[ni] = sub;
+        ctx.nodes[ni] = {first, uint32_t(cnt), sub};
         return {int32_t(ni), 0};
     }
 
@@ -396,47 +462,58 @@ struct WideSAHBVHBuilder {
     // the second's, ... Subtree sizes give every position up front, so large subtrees
     // are placed in parallel.
     template <int K>
-    static void place(const WideBVHNode<K>* in, const uint32_t* subtree, WideBVHNode<K>* out, uint32_t oi, uint32_t ni,
+    static void place(const ScratchNode* in, const ScratchKid* kids, WideBVHNode<K>* out, uint32_t oi, uint32_t ni,
                       uint32_t free) {
-        WideBVHNode<K> d = in[oi];
+        const ScratchNode& s = in[oi];
         uint32_t inner = 0;
-        for (int i = 0; i < K; ++i) inner += d.child[i] >= 0 && !d.isLeaf(i);
+        for (uint32_t i = 0; i < s.kids; ++i) inner += kids[s.first + i].count == 0;
+        WideBVHNode<K> d;
         uint32_t kidOld[K], kidNew[K], kidFree[K], m = 0, next = free + inner;
         for (int i = 0; i < K; ++i) {
-            if (d.child[i] < 0 || d.isLeaf(i)) continue;
-            kidOld[m] = uint32_t(d.child[i]);
+            if (uint32_t(i) >= s.kids) {
+                d.clear(i);
+                continue;
+            }
+            const ScratchKid& k = kids[s.first + uint32_t(i)];
+            if (k.count > 0) {
+                d.set(i, k.box(), k.child, k.count);
+                continue;
+            }
+            kidOld[m] = uint32_t(k.child);
             kidNew[m] = free + m;
             kidFree[m] = next;
-            next += subtree[kidOld[m]] - 1;
-            d.child[i] = int32_t(kidNew[m]);
+            next += in[kidOld[m]].subtree - 1;
+            d.set(i, k.box(), int32_t(kidNew[m]), 0);
             ++m;
         }
         out[ni] = d;
-        if (subtree[oi] >= kParallelPlace) {
+        if (s.subtree >= kParallelPlace) {
             tbb::task_group g;
-            for (uint32_t j = 0; j < m; ++j)
-                g.run([=] { place<K>(in, subtree, out, kidOld[j], kidNew[j], kidFree[j]); });
+            for (uint32_t j = 0; j < m; ++j) g.run([=] { place<K>(in, kids, out, kidOld[j], kidNew[j], kidFree[j]); });
             g.wait();
         } else {
-            for (uint32_t j = 0; j < m; ++j) place<K>(in, subtree, out, kidOld[j], kidNew[j], kidFree[j]);
+            for (uint32_t j = 0; j < m; ++j) place<K>(in, kids, out, kidOld[j], kidNew[j], kidFree[j]);
         }
     }
 };
 
 template <int K>
 void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& out) const {
-    const uint32_t n = uint32_t(bounds.size());
+    build(
+        uint32_t(bounds.size()), [&](uint32_t i) { return bounds[i]; }, out);
+}
+
+template <int K, class BoundsOf>
+requires std::is_invocable_r_v<AABB, const BoundsOf&, uint32_t>
+void WideSAHBVHBuilder::build(uint32_t n, const BoundsOf& boundsOf, WideBVHTopology<K>& out) const {
     out.nodes.clear();
     out.order.clear();
     out.box = AABB{};
     if (n == 0) return;
-    // Two reference buffers (the parallel partition of the top levels goes from one to
-    // the other), first touched by the threads that fill them.
-    std::vector<Ref, UninitAllocator<Ref>> refs[2];
-    resizeHugePages(refs[0], n);
-    // One thread: everything serial and in place (no second buffer to fault in).
+    // The references, first touched by the threads that fill them.
+    std::vector<Ref, UninitAllocator<Ref>> refs;
+    resizeHugePages(refs, n);
     const bool parallel = tbb::this_task_arena::max_concurrency() > 1;
-    if (parallel) resizeHugePages(refs[1], n);
     resizeHugePages(out.order, n);
     // References and the root's bounds, in parallel.
     struct Boxes {
@@ -446,9 +523,9 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
         tbb::blocked_range<uint32_t>(0, n, kGrain), Boxes{},
         [&](const tbb::blocked_range<uint32_t>& br, Boxes acc) {
             for (uint32_t i = br.begin(); i != br.end(); ++i) {
-                Ref& r = refs[0][i];
-                r = {{bounds[i].lo.x, bounds[i].lo.y, bounds[i].lo.z, 0.0f},
-                     {bounds[i].hi.x, bounds[i].hi.y, bounds[i].hi.z, 0.0f}};
+                const AABB b = boundsOf(i);
+                Ref& r = refs[i];
+                r = {{b.lo.x, b.lo.y, b.lo.z, 0.0f}, {b.hi.x, b.hi.y, b.hi.z, 0.0f}};
                 std::memcpy(&r.lo[3], &i, 4);
                 extend(acc.box, acc.cbox, r);
             }
@@ -459,20 +536,19 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
             x.cbox.extend(y.cbox);
             return x;
         });
-    // At most n - 1 inner nodes (each has two or more children); untouched pages of
-    // this upper bound cost nothing.
-    std::vector<WideBVHNode<K>, UninitAllocator<WideBVHNode<K>>> nodes;
+    // At most n - 1 inner nodes (each has two or more children) and 2n - 2 children;
+    // untouched pages of these upper bounds cost nothing.
+    std::vector<ScratchNode, UninitAllocator<ScratchNode>> nodes;
     resizeHugePages(nodes, std::max<uint32_t>(n, 1));
-    std::vector<uint32_t, UninitAllocator<uint32_t>> subtree;
-    resizeHugePages(subtree, std::max<uint32_t>(n, 1));
+    std::vector<ScratchKid, UninitAllocator<ScratchKid>> kids;
+    resizeHugePages(kids, 2 * size_t(std::max<uint32_t>(n, 1)));
     Ctx ctx;
-    ctx.buf[0] = refs[0].data();
-    ctx.buf[1] = refs[1].data();
+    ctx.refs = refs.data();
     ctx.parallelSplit = parallel ? kParallelSplit : std::numeric_limits<uint32_t>::max();
     ctx.parallelSplitBelowRoot = parallel ? std::max(kParallelSplit, n / 4) : std::numeric_limits<uint32_t>::max();
     ctx.order = out.order.data();
     ctx.nodes = nodes.data();
-    ctx.subtree = subtree.data();
+    ctx.kids = kids.data();
     Range r;
     r.b = 0, r.e = n, r.box = root.box, r.cbox = root.cbox;
     out.box = root.box.aabb();
@@ -486,7 +562,7 @@ void WideSAHBVHBuilder::build(std::span<const AABB> bounds, WideBVHTopology<K>& 
     }
     // Depth-first order (children after their parent) for locality; the root is node 0.
     resizeHugePages(out.nodes, ctx.next.load());
-    place<K>(nodes.data(), subtree.data(), out.nodes.data(), uint32_t(top.first), 0, 1);
+    place<K>(nodes.data(), kids.data(), out.nodes.data(), uint32_t(top.first), 0, 1);
 }
 
 static_assert(Builder<WideSAHBVHBuilder, WideBVHTopology<4>>);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <functional>
 #include <random>
 
@@ -325,14 +326,14 @@ TEST(WideBVH, DirectStructureTriangles) {
     checkDirectStructure<8>(t, 4);
     checkDirectStructure<16>(t, 8);
 }
-// Large enough for the parallel binning and out-of-place partition of the top levels.
+// Large enough for the parallel binning and in-place parallel partition of the top levels.
 TEST(WideBVH, DirectStructureParallelTop) {
     const auto s = testSpheres(70000);
     checkDirectStructure<8>(s, 4);
 }
-// On one thread the builder partitions serially in place (no second reference buffer);
-// with more it partitions the top levels out of place in parallel. Both are valid trees
-// of the same shape: binning does not depend on the order within a range.
+// On one thread the builder partitions serially; with more it partitions the top levels
+// in parallel (other swaps, so another order within a range). Both are valid trees of
+// the same shape: binning does not depend on the order within a range.
 void expectOneThreadMatchesParallel(const std::vector<Sphere>& s) {
     tbb::task_arena one(1), two(2);
     one.execute([&] { checkDirectStructure<8>(s, 4); });
@@ -378,6 +379,22 @@ void expectOneThreadMatchesParallel(const std::vector<Sphere>& s) {
         }
 }
 TEST(WideBVH, DirectStructureOneThreadMatchesParallel) { expectOneThreadMatchesParallel(testSpheres(70000)); }
+// Bounds from a function (the mesh path: no bounds array) give the very same tree as
+// the array, in parallel too.
+TEST(WideBVH, DirectBoundsFunctionMatchesArray) {
+    const std::vector<AABB> bounds = boundsOf(testSpheres(70000));
+    tbb::task_arena two(2);
+    WideBVHTopology<16> a, b;
+    two.execute([&] {
+        WideSAHBVHBuilder{}.build(std::span<const AABB>(bounds), a);
+        WideSAHBVHBuilder{}.build(
+            uint32_t(bounds.size()), [&](uint32_t i) { return bounds[i]; }, b);
+    });
+    EXPECT_EQ(a.order, b.order);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(a.nodes[0])), 0);
+    checkTopology<16>(b, bounds, false);
+}
 // Three quarters of the spheres in a tiny cluster in a corner: the first split cuts it
 // off and the root's widening never opens that small child, so ranges below the root
 // are large enough to bin and partition in parallel too.
