@@ -37,19 +37,20 @@ inline std::vector<Triangle> meshTriangles(const Mesh& m) {
     return t;
 }
 
+// Bounds of triangle t of m.
+inline AABB meshTriangleBox(const Mesh& m, size_t t) {
+    const Vec3f a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
+                c = m.positions[m.indices[3 * t + 2]];
+    return {vmin(vmin(a, b), c), vmax(vmax(a, b), c)};
+}
+
 // Bounds of the triangles in index order, computed in parallel on huge pages.
 inline std::vector<AABB> meshTriangleBounds(const Mesh& m) {
     const size_t n = m.triangles();
     std::vector<AABB> bounds;
     resizeHugePages(bounds, n);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            AABB b;
-            b.extend(m.positions[m.indices[3 * i]])
-                .extend(m.positions[m.indices[3 * i + 1]])
-                .extend(m.positions[m.indices[3 * i + 2]]);
-            bounds[i] = b;
-        }
+        for (size_t i = r.begin(); i != r.end(); ++i) bounds[i] = meshTriangleBox(m, i);
     });
     return bounds;
 }
@@ -92,11 +93,13 @@ inline WideSAHBVHBuilder meshWideBVHBuilder() {
 }
 using MeshWideBVH = BlockedWideBVH<TriangleBlock<kMeshLeafBlock>, kMeshWideArity>;
 
-// The wide BVH of a mesh from its triangle bounds (index order): built directly, then
-// the leaves packed into triangle blocks straight from the indexed mesh.
-inline MeshWideBVH buildMeshWideBVH(const Mesh& m, std::span<const AABB> bounds) {
+// The wide BVH of a mesh: built directly from the triangles' bounds, computed on the fly
+// from the indexed mesh (no bounds array to fault in), then the leaves packed into
+// triangle blocks straight from the mesh.
+inline MeshWideBVH buildMeshWideBVH(const Mesh& m) {
     WideBVHTopology<kMeshWideArity> topo;
-    meshWideBVHBuilder().build(bounds, topo);
+    meshWideBVHBuilder().build(
+        uint32_t(m.triangles()), [&](uint32_t t) { return meshTriangleBox(m, t); }, topo);
     using Block = TriangleBlock<kMeshLeafBlock>;
     return packLeafBlocks<Block>(std::move(topo), [&](Block& b, const uint32_t* ids, int cnt) {
         b.fill(ids, cnt, [&](uint32_t t) {
@@ -151,11 +154,11 @@ struct MeshScene {
             // intermediate triangle array: first-touch page faults dominate big builds).
             const Mesh& m = *mesh;
             const size_t n = m.triangles();
-            const std::vector<AABB> bounds = meshTriangleBounds(m);
             accel = BVH<Triangle>{};
             wide = {};
-            if (buildWide) wide = buildMeshWideBVH(m, std::span<const AABB>(bounds));
+            if (buildWide) wide = buildMeshWideBVH(m);
             if (buildWide && n > packetBVHMaxTriangles) return finishBuild();
+            const std::vector<AABB> bounds = meshTriangleBounds(m);
             meshBVHBuilder().build(std::span<const AABB>(bounds), static_cast<BVHTopology&>(accel));
             resizeHugePages(accel.elems, n);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
