@@ -11,6 +11,8 @@
 // products (three edges and the plane).
 #pragma once
 #include <algorithm>
+#include <cstring>
+#include <utility>
 
 #include "core/accel/wide_bvh_intersector.h"
 #include "core/accel/wide_bvh_packet_intersector.h"
@@ -223,27 +225,90 @@ struct TriangleIntersector {
     }
 
     // Blocks of a BlockedWideBVH leaf: the same arithmetic as intersectLeaf, loaded
-    // straight from structure-of-arrays.
+    // straight from structure-of-arrays. Where two blocks fill one native SIMD op
+    // (AVX-512, blocks of 8) they are tested as one: the same per-lane values, and the
+    // nearest (first on ties) lane is the one the block-by-block test would keep.
     template <HitData D, int L>
     RTFACT_INLINE void intersectBlocks(const TriangleBlock<L>* blocks, int n, const RayPacket<1>& ray,
                                        Hit<1>& hit) const {
-        for (int k = 0; k < n; ++k) {
+        int k = 0;
+        if constexpr (kPairBlocks<L>) {
+            for (; k + 1 < n; k += 2) {
+                Packet<2 * L> e0, e1, e2, t;
+                const auto m = pairTest(blocks[k], blocks[k + 1], ray, float(hit.t), e0, e1, e2, t);
+                if (!none(m)) {
+                    int32_t ids[2 * L];
+                    std::memcpy(ids, blocks[k].id, sizeof(blocks[k].id));
+                    std::memcpy(ids + L, blocks[k + 1].id, sizeof(blocks[k].id));
+                    takeNearest<D>(m, t, e0, e1, e2, ids, hit);
+                }
+            }
+        }
+        for (; k < n; ++k) {
             Packet<L> e0, e1, e2, t;
             const auto m = blockTest(blocks[k], ray, float(hit.t), e0, e1, e2, t);
             if (!none(m)) takeNearest<D>(m, t, e0, e1, e2, blocks[k].id, hit);
         }
     }
-    // Any hit in (tMin, hit.t): records it in hit and returns true.
+    // Any hit in (tMin, hit.t): records it in hit and returns true (the first hit lane of
+    // the first block with one, paired or not).
     template <int L>
     RTFACT_INLINE bool occludedBlocks(const TriangleBlock<L>* blocks, int n, const RayPacket<1>& ray,
                                       Hit<1>& hit) const {
-        return firstBlockHit<L>(blocks, n, hit, [&](const TriangleBlock<L>& b, Packet<L>& t) {
+        int k = 0;
+        if constexpr (kPairBlocks<L>) {
+            for (; k + 1 < n; k += 2) {
+                Packet<2 * L> e0, e1, e2, t;
+                const auto m = pairTest(blocks[k], blocks[k + 1], ray, float(hit.t), e0, e1, e2, t);
+                if (none(m)) continue;
+                const int lane = BitMask<2 * L>(m).first();
+                hit.t = t[lane];
+                hit.id = lane < L ? blocks[k].id[lane] : blocks[k + 1].id[lane - L];
+                return true;
+            }
+        }
+        return firstBlockHit<L>(blocks + k, n - k, hit, [&](const TriangleBlock<L>& b, Packet<L>& t) {
             Packet<L> e0, e1, e2;
             return blockTest(b, ray, float(hit.t), e0, e1, e2, t);
         });
     }
 
    private:
+    template <int L>
+    static constexpr bool kPairBlocks = 2 * L <= simd::kNativeWidth;
+
+    // Lanes [0, L) from a, [L, 2L) from b, as one packet.
+    template <int L>
+    static RTFACT_INLINE Packet<2 * L> pairLoad(const float* a, const float* b) {
+        using P2 = Packet<2 * L>;
+        P2 r;
+        if constexpr (P2::C == 2) {
+            r.c[0] = Packet<L>::load(a).c[0];
+            r.c[1] = Packet<L>::load(b).c[0];
+        } else {
+            r.c[0] = concatChunks(Packet<L>::load(a).c[0], Packet<L>::load(b).c[0], std::make_index_sequence<2 * L>{});
+        }
+        return r;
+    }
+    template <class V, size_t... I>
+    static RTFACT_INLINE auto concatChunks(V x, V y, std::index_sequence<I...>) {
+        return __builtin_shufflevector(x, y, I...);
+    }
+    // Blocks a and b against one ray as 2L lanes (blockTest's arithmetic).
+    template <int L>
+    static RTFACT_INLINE auto pairTest(const TriangleBlock<L>& a, const TriangleBlock<L>& b, const RayPacket<1>& ray,
+                                       float tFar, Packet<2 * L>& e0, Packet<2 * L>& e1, Packet<2 * L>& e2,
+                                       Packet<2 * L>& t) {
+        constexpr int L2 = 2 * L;
+        using P = Packet<L2>;
+        const float o[3] = {ray.org.x[0], ray.org.y[0], ray.org.z[0]};
+        Vec3<L2> v[3];
+        for (int j = 0; j < 3; ++j)
+            v[j] = Vec3<L2>(pairLoad<L>(a.v[j][0], b.v[j][0]) - P(o[0]), pairLoad<L>(a.v[j][1], b.v[j][1]) - P(o[1]),
+                            pairLoad<L>(a.v[j][2], b.v[j][2]) - P(o[2]));
+        const Vec3<L2> d(Vec3f(ray.dir.x[0], ray.dir.y[0], ray.dir.z[0]));
+        return laneTest(v[0], v[1], v[2], d, float(ray.tMin), tFar, e0, e1, e2, t);
+    }
     template <int L>
     static RTFACT_INLINE auto blockTest(const TriangleBlock<L>& b, const RayPacket<1>& ray, float tFar, Packet<L>& e0,
                                         Packet<L>& e1, Packet<L>& e2, Packet<L>& t) {

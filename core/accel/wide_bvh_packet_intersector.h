@@ -126,20 +126,28 @@ template <int N, class Hit, class Trace>
 void traceInChunkTiles(const RayPacket<N>& rays, Hit& hit, const Trace& trace) {
     using T = PacketChunkTiles<N>;
     if constexpr (T::kEnabled) {
+        // A tile row is cw consecutive lanes on both sides: the regrouping moves whole
+        // rows (one 16-byte copy each) instead of single lanes.
+        constexpr int kRow = T::cw * 4;
+        auto rows = [](auto&& copy) __attribute__((always_inline)) {
+            constexpr int tilesX = T::bw / T::cw;
+            for (int tile = 0; tile < N / T::W; ++tile)
+                for (int y = 0; y < T::ch; ++y)
+                    copy(tile * T::W + y * T::cw, ((tile / tilesX) * T::ch + y) * T::bw + (tile % tilesX) * T::cw);
+        };
         RayPacket<N> r;
         Hit h;
         r.commonOrigin = rays.commonOrigin;
-        for (int i = 0; i < N; ++i) {
-            const int j = T::perm[size_t(i)];
+        rows([&](int i, int j) __attribute__((always_inline)) {
             for (int a = 0; a < 3; ++a) {
-                r.org[a][i] = rays.org[a][j];
-                r.dir[a][i] = rays.dir[a][j];
-                r.invDir[a][i] = rays.invDir[a][j];
+                std::memcpy(&r.org[a][i], &rays.org[a][j], kRow);
+                std::memcpy(&r.dir[a][i], &rays.dir[a][j], kRow);
+                std::memcpy(&r.invDir[a][i], &rays.invDir[a][j], kRow);
             }
-            r.tMin[i] = rays.tMin[j];
-            r.tMax[i] = rays.tMax[j];
-            h.t[i] = hit.t[j];
-        }
+            std::memcpy(&r.tMin[i], &rays.tMin[j], kRow);
+            std::memcpy(&r.tMax[i], &rays.tMax[j], kRow);
+            std::memcpy(&h.t[i], &hit.t[j], kRow);
+        });
         h.id = Packet<N, int32_t>(-1);
         trace(r, h);
         // Hit records are 4-byte lane packets (as WideBVHIntersector::setHitLane).
@@ -147,10 +155,10 @@ void traceInChunkTiles(const RayPacket<N>& rays, Hit& hit, const Trace& trace) {
         constexpr int kFields = int(sizeof(Hit) / (4 * N));
         auto* d = reinterpret_cast<unsigned char*>(&hit);
         const auto* src = reinterpret_cast<const unsigned char*>(&h);
-        for (int f = 0; f < kFields; ++f)
-            for (int i = 0; i < N; ++i)
-                std::memcpy(d + (size_t(f) * N + size_t(T::perm[size_t(i)])) * 4, src + (size_t(f) * N + size_t(i)) * 4,
-                            4);
+        rows([&](int i, int j) __attribute__((always_inline)) {
+            for (int f = 0; f < kFields; ++f)
+                std::memcpy(d + (size_t(f) * N + size_t(j)) * 4, src + (size_t(f) * N + size_t(i)) * 4, kRow);
+        });
     } else {
         hit.id = Packet<N, int32_t>(-1);
         trace(rays, hit);
@@ -361,13 +369,16 @@ struct WideBVHPacketIntersector {
             return tn <= tf;
         };
         // An entry remembers its parent and slot, so its lanes are tested again against the
-        // hits found since it was pushed.
+        // hits found since it was pushed; `leaves` counts the leaves run so far, an entry
+        // popped with no leaf run since its push has nothing to test again.
         struct Entry {
             int32_t child, count;
             float dist;
             uint32_t lanes;
             int32_t parent, slot;
+            uint32_t leaves;
         };
+        uint32_t leaves = 0;
         Entry stack[(K - 1) * 128 + 1];
         int sp = 0;
         int32_t node = start;
@@ -387,7 +398,7 @@ struct WideBVHPacketIntersector {
                 const Mask<W> m = laneHits(f, c, tn);
                 const uint32_t hitLanes = uint32_t(BitMask<W>(m).w[0]) & nodeLanes;
                 if (!hitLanes) continue;
-                Entry e{n.child[c], n.count[c], 0.0f, hitLanes, node, c};
+                Entry e{n.child[c], n.count[c], 0.0f, hitLanes, node, c, leaves};
                 if constexpr (AnyHit) {
                     stack[sp++] = e;
                 } else {
@@ -408,9 +419,11 @@ struct WideBVHPacketIntersector {
                 } else {
                     if (!(e.dist <= fr.tMaxHi)) continue;
                     // Lanes that found a hit in front of the entry leave it.
-                    P tn;
-                    e.lanes &= uint32_t(BitMask<W>(laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn)).w[0]);
-                    if (!e.lanes) continue;
+                    if (e.leaves != leaves) {
+                        P tn;
+                        e.lanes &= uint32_t(BitMask<W>(laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn)).w[0]);
+                        if (!e.lanes) continue;
+                    }
                 }
                 const int lanesHit = __builtin_popcount(e.lanes);
                 const bool few =
@@ -420,6 +433,7 @@ struct WideBVHPacketIntersector {
                     nodeLanes = e.lanes;
                     break;
                 }
+                ++leaves;  // single rays from an inner node count too: they may find hits
                 if (few && e.count == 0) {
                     for (uint32_t b = e.lanes; b; b &= b - 1)
                         singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), e.child, e.count);
