@@ -176,7 +176,8 @@ double processCpuMs() {
 
 template <int N>
 int run(const std::string& file, std::shared_ptr<PointScene> built, const PinholeCamera& cam, int w, int h, int all,
-        int repeat, std::vector<float> qualities, std::vector<float> repScales, int leafSize, double loadMs) {
+        int repeat, std::vector<float> qualities, std::vector<float> repScales, int leafSize, double loadMs,
+        bool lodOnly) {
     const float quality = qualities.front();
     // The engine's scene renders; the rebuilds below only time the builder on its discs.
     PointScene& scene = *built;
@@ -193,6 +194,24 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
                                                : " (median)",
         w, h, N, all, quality, repScales.front(), loadMs);
     const std::vector<int> threadCounts = all > 1 ? std::vector<int>{1, all} : std::vector<int>{1};
+    if (lodOnly) {  // quick A/B of the LoD traversal: no builds timed, no peer
+        std::printf("memory: rtfact_bytes_per_point=%.2f\n", double(scene.memoryBytes()) / double(n));
+        Frame ff(w, h), fl(w, h);
+        RTfactSide<N> rt{scene, cam};
+        scene.setLoD(cam.cone(), 0.0f);
+        timeTiles(all, w, h, [&](int x, int y) { rt.tile(ff, x, y); });
+        for (float q : qualities) {
+            scene.setLoD(cam.cone(), q, repScales.front());
+            for (int T : threadCounts) {
+                double lod = 1e30;
+                for (int r = 0; r < repeat; ++r)
+                    lod = std::min(lod, timeTiles(T, w, h, [&](int x, int y) { rt.tile(fl, x, y); }));
+                std::printf("quality=%.3g threads=%d lod_frame_ms=%.1f psnr_lod_vs_full=%.2f\n", q, T, lod,
+                            psnr8(fl, ff));
+            }
+        }
+        return 0;
+    }
     LoDKdTreeBuilder builder;
     builder.maxLeafSize = leafSize;
     double rtBuild = 1e30, rtCpu = 1e30;
@@ -291,6 +310,7 @@ int benchPoints(int argc, char** argv) {
     float fov = 45.0f, radius = 0.0f, radiusFactor = 1.0f;
     std::vector<float> quality{1.0f}, repScale{0.7f};
     int threads = 0, packet = 16, repeat = 3, leafSize = 8;
+    bool lodOnly = false;
     app.add_option("FILE", file, "Point cloud (.ply .pcd .xyz .pts)")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");
     app.add_option("--at", at, "Camera target x,y,z");
@@ -320,6 +340,8 @@ int benchPoints(int argc, char** argv) {
     app.add_option("--leaf-size", leafSize, "Maximum points per kd-tree leaf")
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
+    app.add_flag("--lod-only", lodOnly,
+                 "Only the LoD frames (and PSNR against one full frame): no builds timed, no Embree");
     app.add_option("--radius", radius, "Disc radius for every point");
     app.add_option("--radius-factor", radiusFactor, "Scale of the radii")->capture_default_str();
     app.add_option("--normals", normals, "auto|estimate|file")->capture_default_str();
@@ -367,13 +389,13 @@ int benchPoints(int argc, char** argv) {
     const int all = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
     switch (packet) {
         case 1:
-            return run<1>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<1>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs, lodOnly);
         case 16:
-            return run<16>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<16>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs, lodOnly);
         case 256:
-            return run<256>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<256>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs, lodOnly);
         default:
-            return run<64>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs);
+            return run<64>(file, scene, cam, w, h, all, repeat, quality, repScale, leafSize, loadMs, lodOnly);
     }
 }
 

@@ -42,11 +42,13 @@ Sum leafBlock(LoDWideBVH& t, uint32_t first, uint32_t n) {
     return k;
 }
 
-// How a range of `count` discs is cut into the (at most K) children of a wide node: the
-// largest part of more than S discs is halved, at a multiple of S, until there are K.
-// It depends on the count only, so node slots are known before the discs are sorted,
-// every part starts at a multiple of S (leaves are exactly one block) and siblings stay
-// in memory order.
+// How a range of `count` discs is cut into the (at most K) children of a wide node. The
+// children are complete subtrees of `cap` = S K^j discs (the largest such below count),
+// the last one holding the rest: a part of more than cap discs is halved at a multiple of
+// cap, the largest first, until none is left. Nodes are then full (K children) but along
+// the right edge, the tree has ~1/(K-1) nodes per block, and every part starts at a
+// multiple of S (leaves are exactly one block). The plan depends on the count only, so
+// node slots are known before the discs are sorted; siblings stay in memory order.
 struct Plan {
     int parts = 1;
     uint32_t first[K] = {0}, count[K] = {0};
@@ -56,12 +58,14 @@ struct Plan {
 Plan makePlan(uint32_t count) {
     Plan p;
     p.count[0] = count;
+    uint64_t cap = S;
+    while (cap * K < count) cap *= K;
     for (int step = 0; p.parts < K; ++step) {
         int best = -1;
         for (int i = 0; i < p.parts; ++i)
-            if (p.count[i] > uint32_t(S) && (best < 0 || p.count[i] > p.count[best])) best = i;
+            if (p.count[i] > cap && (best < 0 || p.count[i] > p.count[best])) best = i;
         if (best < 0) break;
-        const uint32_t h = (p.count[best] + S - 1) / S / 2 * S;
+        const uint32_t h = uint32_t((p.count[best] + cap - 1) / cap / 2 * cap);
         for (int i = p.parts; i > best + 1; --i) p.first[i] = p.first[i - 1], p.count[i] = p.count[i - 1];
         p.first[best + 1] = p.first[best] + h;
         p.count[best + 1] = p.count[best] - h;

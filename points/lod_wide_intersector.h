@@ -76,8 +76,8 @@ struct LoDWideIntersector {
     // The ray against the representatives of the children in `cut`; returns true when an
     // any-hit query is done.
     template <bool AnyHit>
-    RTFACT_INLINE bool cutChildren(const LoDChildReps<K>& r, int32_t node, uint64_t cut, const RayPacket<1>& ray,
-                                   Hit<1>& hit) const {
+    RTFACT_INLINE bool cutChildren(const LoDWideBVH& bvh, const LoDChildReps<K>& r, int32_t node, uint64_t cut,
+                                   const RayPacket<1>& ray, Hit<1>& hit) const {
         const P rr = P::load(r.radius) * P(repScale);
         const auto [t, dist2] = rayDiscPlane(r.c, r.n, ray);
         uint64_t m = BitMask<K>((dist2 <= rr * rr) & (t > P(float(ray.tMin))) & (t < P(float(hit.t)))).w[0] & cut;
@@ -95,6 +95,7 @@ struct LoDWideIntersector {
             if (t[c] < bt) bt = t[c], best = c;
         }
         if (best >= 0) {
+            __builtin_prefetch(&bvh.reps[size_t(node) * K + size_t(best)]);  // for the shading
             hit.t = bt;
             hit.id = LoDWideBVH::repId(node, best);
         }
@@ -153,7 +154,7 @@ struct LoDWideIntersector {
                 const uint64_t cut = bits & BitMask<K>(P::load(r.radius) <= cutBase + cutSlope * max(tn, P(0.0f))).w[0];
                 if (cut) {
                     bits &= ~cut;
-                    if (cutChildren<AnyHit>(r, node, cut, ray, hit)) return;
+                    if (cutChildren<AnyHit>(bvh, r, node, cut, ray, hit)) return;
                 }
             }
             if constexpr (!AnyHit) {
@@ -315,6 +316,7 @@ struct LoDWideIntersector {
             P entry;
             uint64_t cand = fr.template children<CommonOrigin, K>(f, entry);
             const int base = sp;
+            bool cutHere = false;
             RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the stack");
             for (; cand; cand &= cand - 1) {
                 const int c = __builtin_ctzll(cand);
@@ -327,6 +329,9 @@ struct LoDWideIntersector {
                     const uint32_t cut =
                         m & uint32_t(BitMask<W>(PW(r.radius[c]) <= cutBase + cutSlope * max(tn, PW(0.0f))).w[0]);
                     if (cut) {
+                        cutHere = true;
+                        // Most cut children are hit: their disc (colour) is read by the shading next.
+                        __builtin_prefetch(&bvh.reps[size_t(node) * K + size_t(c)]);
                         const float rr = r.radius[c] * repScale;
                         DiscIntersector::intersectDiscChunk(Vec3f(r.c[0][c], r.c[1][c], r.c[2][c]),
                                                             Vec3f(r.n[0][c], r.n[1][c], r.n[2][c]), rr * rr,
@@ -351,16 +356,22 @@ struct LoDWideIntersector {
                 }
             }
             // Pop the nearest entry that can still hold a closer hit; run leaves and hand
-            // entries with few lanes to single rays.
+            // entries with few lanes to single rays. The first entry popped after a node
+            // where no child was cut was just pushed by it with current lanes: no retest.
+            bool fresh = sp > base && !cutHere;
             for (;;) {
                 if (sp == 0) return;
                 Entry e = stack[--sp];
+                const bool retest = !fresh;
+                fresh = false;
                 if constexpr (AnyHit) {
                     e.lanes &= open;
                 } else {
                     if (!(e.dist <= fr.tMaxHi)) continue;
-                    PW tn;
-                    e.lanes &= laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn);
+                    if (retest) {
+                        PW tn;
+                        e.lanes &= laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn);
+                    }
                 }
                 if (!e.lanes) continue;
                 const int lanesHit = __builtin_popcount(e.lanes);

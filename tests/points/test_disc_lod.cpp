@@ -622,6 +622,33 @@ RepHitStats checkWideRepresentativeHits(const PointScene& scene, bool commonOrig
 // Builder invariants of the LoD summaries: each child's representative covers every disc
 // of the child's subtree, the SoA copy in the parent matches it, its level is the
 // subtree's height, and empty slots are never cut.
+// The median build splits into complete subtrees and one rest: every node is full but at
+// most one per level (the rest's), so the tree has about one node per K-1 blocks.
+TEST(DiscWideBVHMedian, NodesAreFullButOnePerLevel) {
+    constexpr int K = DiscWideBVH::arity;
+    for (int n : {129, 5000, 40000}) {
+        SCOPED_TRACE(n);
+        const LoDWideBVH w = buildLoDWideBVH(randomDiscs(n, 51 + uint32_t(n)), LoDWideSplit::Median);
+        std::vector<int> partialPerLevel;
+        std::vector<std::pair<int32_t, int>> work{{0, 0}};
+        while (!work.empty()) {
+            const auto [ni, level] = work.back();
+            work.pop_back();
+            if (size_t(level) >= partialPerLevel.size()) partialPerLevel.resize(size_t(level) + 1, 0);
+            const auto& node = w.nodes[size_t(ni)];
+            int kids = 0;
+            for (int c = 0; c < K; ++c) {
+                if (node.isEmpty(c)) continue;
+                ++kids;
+                if (!node.isLeaf(c)) work.push_back({node.child[c], level + 1});
+            }
+            partialPerLevel[size_t(level)] += kids < K;
+        }
+        for (size_t l = 0; l < partialPerLevel.size(); ++l) EXPECT_LE(partialPerLevel[l], 1) << "level " << l;
+        EXPECT_LE(w.nodes.size(), w.blocks.size() / (K - 1) + partialPerLevel.size() + 1);
+    }
+}
+
 TEST_P(DiscWideBVHSplit, ChildRepresentativesCoverTheirSubtrees) {
     const PointScene scene = [] {
         PointScene s;
