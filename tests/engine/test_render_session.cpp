@@ -178,15 +178,17 @@ TEST(RenderSession, CancelFromAnotherThreadStopsWithinOneTile) {
     bool reached = false;
     std::atomic<bool> armed{true}, cancelled{false};
     std::atomic<int> tiles{0}, tilesAfterCancel{0};
+    // Every tile finished after the third waits for the cancel: otherwise the other worker
+    // could render all the rest before thread b wakes up (it did, once the mesh got faster).
     session.onProgress([&](uint64_t done, uint64_t) {
         ++tiles;
         if (cancelled) ++tilesAfterCancel;
+        std::unique_lock l(m);
         if (done == 3 && armed.exchange(false)) {
-            std::unique_lock l(m);
             reached = true;
             cv.notify_all();
-            cv.wait(l, [&] { return cancelled.load(); });
         }
+        if (reached) cv.wait(l, [&] { return cancelled.load(); });
     });
     std::thread b([&] {
         std::unique_lock l(m);
