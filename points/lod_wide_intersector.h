@@ -316,7 +316,6 @@ struct LoDWideIntersector {
             P entry;
             uint64_t cand = fr.template children<CommonOrigin, K>(f, entry);
             const int base = sp;
-            bool cutHere = false;
             RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]), "wide BVH deeper than the stack");
             for (; cand; cand &= cand - 1) {
                 const int c = __builtin_ctzll(cand);
@@ -329,7 +328,6 @@ struct LoDWideIntersector {
                     const uint32_t cut =
                         m & uint32_t(BitMask<W>(PW(r.radius[c]) <= cutBase + cutSlope * max(tn, PW(0.0f))).w[0]);
                     if (cut) {
-                        cutHere = true;
                         // Most cut children are hit: their disc (colour) is read by the shading next.
                         __builtin_prefetch(&bvh.reps[size_t(node) * K + size_t(c)]);
                         const float rr = r.radius[c] * repScale;
@@ -356,22 +354,16 @@ struct LoDWideIntersector {
                 }
             }
             // Pop the nearest entry that can still hold a closer hit; run leaves and hand
-            // entries with few lanes to single rays. The first entry popped after a node
-            // where no child was cut was just pushed by it with current lanes: no retest.
-            bool fresh = sp > base && !cutHere;
+            // entries with few lanes to single rays.
             for (;;) {
                 if (sp == 0) return;
                 Entry e = stack[--sp];
-                const bool retest = !fresh;
-                fresh = false;
                 if constexpr (AnyHit) {
                     e.lanes &= open;
                 } else {
                     if (!(e.dist <= fr.tMaxHi)) continue;
-                    if (retest) {
-                        PW tn;
-                        e.lanes &= laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn);
-                    }
+                    PW tn;
+                    e.lanes &= laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn);
                 }
                 if (!e.lanes) continue;
                 const int lanesHit = __builtin_popcount(e.lanes);

@@ -249,7 +249,7 @@ struct WideSAHBVHBuilder {
         return s;
     }
 
-    // Splits r into l and rr (the references move to the children's buffers).
+    // Splits r into l and rr, in place.
     void partition(Ctx& ctx, const Range& r, const Split& s, Range& l, Range& rr) const {
         Ref* src = ctx.refs;
         l = Range{};
