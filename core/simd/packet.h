@@ -44,12 +44,16 @@ struct __attribute__((may_alias)) Packet {
         p.c[0] = v;
         return p;
     }
-    static Packet load(const T* p) {
+    // Chunk by chunk: one memcpy over the whole array becomes 16-byte moves through the
+    // stack (GCC 12), and each chunk's read then misses store forwarding.
+    static RTFACT_INLINE Packet load(const T* p) {
         Packet r;
-        std::memcpy(r.c, p, sizeof(r.c));
+        for (int i = 0; i < C; ++i) std::memcpy(&r.c[i], p + i * W, sizeof(Chunk));
         return r;
     }
-    void store(T* p) const { std::memcpy(p, c, sizeof(c)); }
+    RTFACT_INLINE void store(T* p) const {
+        for (int i = 0; i < C; ++i) std::memcpy(p + i * W, &c[i], sizeof(Chunk));
+    }
     // Lane i = start + i * step.
     static Packet ramp(T start, T step = T(1)) {
         Packet r;
