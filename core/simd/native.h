@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <type_traits>
+#include <utility>
 
 #if defined(RTFACT_FORCE_SCALAR)
 #define RTFACT_NATIVE_WIDTH 1
@@ -383,10 +384,35 @@ RTFACT_INLINE nvec<float, W> toFloat(nvec<int32_t, W> a) {
         return __builtin_convertvector(a, nvec<float, W>);
 }
 
+namespace detail {
+template <class V, size_t... I>
+RTFACT_INLINE auto shuffleLanes(V a, std::index_sequence<I...>) {
+    return __builtin_shufflevector(a, a, int(I)...);
+}
+template <size_t Off, size_t... I>
+constexpr auto offsetSeq(std::index_sequence<I...>) {
+    return std::index_sequence<(I + Off)...>{};
+}
+// Lanes [0, W/2) and [W/2, W) of a W-lane vector, as W/2-lane vectors.
+template <int W, class V>
+RTFACT_INLINE auto lowHalf(V a) {
+    return shuffleLanes(a, std::make_index_sequence<W / 2>{});
+}
+template <int W, class V>
+RTFACT_INLINE auto highHalf(V a) {
+    return shuffleLanes(a, offsetSeq<W / 2>(std::make_index_sequence<W / 2>{}));
+}
+}  // namespace detail
+
+// Horizontal min/max: halves folded with one vector min per level (log2 W dependent
+// steps, not W - 1); the last four lanes one by one. Same result as a lane-by-lane scan
+// for inputs without NaN.
 template <int W, class V>
 RTFACT_INLINE auto hmin(V a) {
     if constexpr (W == 1)
         return a;
+    else if constexpr (W > 4)
+        return hmin<W / 2>(vmin<W / 2>(detail::lowHalf<W>(a), detail::highHalf<W>(a)));
     else {
         auto r = a[0];
         for (int i = 1; i < W; ++i) r = a[i] < r ? a[i] : r;
@@ -397,6 +423,8 @@ template <int W, class V>
 RTFACT_INLINE auto hmax(V a) {
     if constexpr (W == 1)
         return a;
+    else if constexpr (W > 4)
+        return hmax<W / 2>(vmax<W / 2>(detail::lowHalf<W>(a), detail::highHalf<W>(a)));
     else {
         auto r = a[0];
         for (int i = 1; i < W; ++i) r = a[i] > r ? a[i] : r;
