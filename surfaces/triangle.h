@@ -108,12 +108,11 @@ struct TriangleIntersector {
                         const Vec3<L>& e2v) __attribute__((always_inline)) {
             const Vec3<L> d(Vec3f(rays.dir.x[i], rays.dir.y[i], rays.dir.z[i]));
             const P e0 = dot(e0v, d), e1 = dot(e1v, d), e2 = dot(e2v, d);
-            const P nd = dot(nn, d);
-            const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
-            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != P(0.0f));
+            const auto inside = edgesAgree(e0, e1, e2);
             if (none(inside)) return;
+            const P nd = dot(nn, d);
             const P t = dot(nn, a) / nd;
-            const auto m = inside & (t > P(float(rays.tMin[i]))) & (t < P(float(hit.t[i])));
+            const auto m = inside & (nd != P(0.0f)) & (t > P(float(rays.tMin[i]))) & (t < P(float(hit.t[i])));
             if (none(m)) return;
             Hit<1> h;
             takeNearest<D>(m, t, e0, e1, e2, b.id, h);
@@ -160,16 +159,15 @@ struct TriangleIntersector {
         // Lanes hit when the three edge functions agree in sign and t is in range. The
         // distance comes from the plane equation (tnum / dot(n, d)), not from the edge
         // sum: edge functions of a small triangle far from the origin lose many bits.
-        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const P& tnum, const P& nd)
+        // plane() gives (tnum, nd), computed only once some lane is inside.
+        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const auto& plane)
             __attribute__((always_inline)) {
-            // A tolerance of 2^-16 of the edge magnitudes closes vertices, where several
-            // near-zero spoke values of one fan may all round to the same side.
-            const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
-            const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != zero);
+            const auto inside = edgesAgree(e0, e1, e2);
             if (none(inside)) return;
+            const auto [tnum, nd] = plane();
             const P t = tnum / nd;
             P& th = hit.t.chunk(k);
-            const auto m = inside & (t > rays.tMin.chunk(k)) & (t < th);
+            const auto m = inside & (nd != zero) & (t > rays.tMin.chunk(k)) & (t < th);
             if (none(m)) return;
             th = select(m, t, th);
             hit.id.chunk(k) = select(m, PI(int32_t(id)), hit.id.chunk(k));
@@ -186,7 +184,7 @@ struct TriangleIntersector {
             const P tnum(dot(n, a));
             for (int k = firstChunk; k < endChunk; ++k) {
                 const Vec3<W> d = rays.dir.chunk(k);
-                finish(k, dot(e0, d), dot(e1, d), dot(e2, d), tnum, dot(nn, d));
+                finish(k, dot(e0, d), dot(e1, d), dot(e2, d), [&] { return std::pair<P, P>(tnum, dot(nn, d)); });
             }
         } else {
             const Vec3<W> v0(tri.v0), v1(tri.v1), v2(tri.v2), nn(n);
@@ -194,7 +192,7 @@ struct TriangleIntersector {
                 const Vec3<W> o = rays.org.chunk(k), d = rays.dir.chunk(k);
                 const Vec3<W> a = v0 - o, b = v1 - o, c = v2 - o;
                 finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d),
-                       dot(nn, a), dot(nn, d));
+                       [&] { return std::pair<P, P>(dot(nn, a), dot(nn, d)); });
             }
         }
     }
@@ -320,6 +318,14 @@ struct TriangleIntersector {
         const Vec3<L> c(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
         return laneTest(a, bb, c, d, float(ray.tMin), tFar, e0, e1, e2, t);
     }
+    // The lanes whose three edge functions agree in sign. A tolerance of 2^-16 of the
+    // edge magnitudes closes vertices, where several near-zero spoke values of one fan
+    // may all round to the same side.
+    template <class P>
+    static RTFACT_INLINE auto edgesAgree(const P& e0, const P& e1, const P& e2) {
+        const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
+        return (min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol);
+    }
     // One ray against L triangles given relative to the ray origin (a, b, c): the same
     // watertight edge functions as the per-triangle test; the lanes hit in (tMin, tFar).
     // t is computed only when some lane is inside.
@@ -328,17 +334,17 @@ struct TriangleIntersector {
                                        float tMin, float tFar, Packet<L>& e0, Packet<L>& e1, Packet<L>& e2,
                                        Packet<L>& t) {
         using P = Packet<L>;
-        // Same values as the per-triangle test: n = (v1 - v0) x (v2 - v0).
-        const Vec3<L> nn = cross(b - a, c - a);
         e0 = dot(triangleEdge(b, c), d);
         e1 = dot(triangleEdge(c, a), d);
         e2 = dot(triangleEdge(a, b), d);
-        const P nd = dot(nn, d);
-        const P tol = (abs(e0) + abs(e1) + abs(e2)) * P(1.0f / 65536.0f);
-        const auto inside = ((min(min(e0, e1), e2) >= -tol) | (max(max(e0, e1), e2) <= tol)) & (nd != P(0.0f));
+        const auto inside = edgesAgree(e0, e1, e2);
         if (none(inside)) return inside;
+        // The plane only once some lane is inside (most tests end above). Same values
+        // as the per-triangle test: n = (v1 - v0) x (v2 - v0).
+        const Vec3<L> nn = cross(b - a, c - a);
+        const P nd = dot(nn, d);
         t = dot(nn, a) / nd;
-        return inside & (t > P(tMin)) & (t < P(tFar));
+        return inside & (nd != P(0.0f)) & (t > P(tMin)) & (t < P(tFar));
     }
     // Records the nearest lane of mask m (not empty) in hit; ids[lane] is its triangle.
     template <HitData D, int L, class Mk, class Id>
