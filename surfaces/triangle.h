@@ -130,10 +130,10 @@ struct TriangleIntersector {
             bb = Vec3<L>(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
             c = Vec3<L>(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
         };
+        const Vec3<L> nn = blockNormal(b);  // origin-free: once per block
         if (rays.commonOrigin) {
             Vec3<L> a, bb, c;
             rel(Vec3f(rays.org.x[0], rays.org.y[0], rays.org.z[0]), a, bb, c);
-            const Vec3<L> nn = cross(bb - a, c - a);
             const Vec3<L> e0v = triangleEdge(bb, c), e1v = triangleEdge(c, a), e2v = triangleEdge(a, bb);
             for (uint32_t r = lanes; r; r &= r - 1) lane(k * W + __builtin_ctz(r), a, nn, e0v, e1v, e2v);
         } else {
@@ -141,7 +141,7 @@ struct TriangleIntersector {
                 const int i = k * W + __builtin_ctz(r);
                 Vec3<L> a, bb, c;
                 rel(Vec3f(rays.org.x[i], rays.org.y[i], rays.org.z[i]), a, bb, c);
-                lane(i, a, cross(bb - a, c - a), triangleEdge(bb, c), triangleEdge(c, a), triangleEdge(a, bb));
+                lane(i, a, nn, triangleEdge(bb, c), triangleEdge(c, a), triangleEdge(a, bb));
             }
         }
         return found;
@@ -217,7 +217,14 @@ struct TriangleIntersector {
                 c.setLane(i, t.v2 - of);
             }
             P e0, e1, e2, t;
-            const auto m = laneTest(a, b, c, d, float(ray.tMin), float(hit.t), e0, e1, e2, t);
+            const auto m = laneTest(a, b, c, d, float(ray.tMin), float(hit.t), e0, e1, e2, t, [&] {
+                Vec3<L> nn;
+                for (int i = 0; i < L; ++i) {
+                    const Triangle& tri = tris[base + std::min(i, n - 1)];
+                    nn.setLane(i, cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+                }
+                return nn;
+            });
             if (!none(m)) takeNearest<D>(m, t, e0, e1, e2, ids + base, hit);
         }
     }
@@ -305,7 +312,21 @@ struct TriangleIntersector {
             v[j] = Vec3<L2>(pairLoad<L>(a.v[j][0], b.v[j][0]) - P(o[0]), pairLoad<L>(a.v[j][1], b.v[j][1]) - P(o[1]),
                             pairLoad<L>(a.v[j][2], b.v[j][2]) - P(o[2]));
         const Vec3<L2> d(Vec3f(ray.dir.x[0], ray.dir.y[0], ray.dir.z[0]));
-        return laneTest(v[0], v[1], v[2], d, float(ray.tMin), tFar, e0, e1, e2, t);
+        return laneTest(v[0], v[1], v[2], d, float(ray.tMin), tFar, e0, e1, e2, t, [&] {
+            Vec3<L2> w[3];
+            for (int j = 0; j < 3; ++j)
+                w[j] = Vec3<L2>(pairLoad<L>(a.v[j][0], b.v[j][0]), pairLoad<L>(a.v[j][1], b.v[j][1]),
+                                pairLoad<L>(a.v[j][2], b.v[j][2]));
+            return cross(w[1] - w[0], w[2] - w[0]);
+        });
+    }
+    // The normals (v1 - v0) x (v2 - v0) of a block's triangles.
+    template <int L>
+    static RTFACT_INLINE Vec3<L> blockNormal(const TriangleBlock<L>& b) {
+        using P = Packet<L>;
+        Vec3<L> w[3];
+        for (int j = 0; j < 3; ++j) w[j] = Vec3<L>(P::load(b.v[j][0]), P::load(b.v[j][1]), P::load(b.v[j][2]));
+        return cross(w[1] - w[0], w[2] - w[0]);
     }
     template <int L>
     static RTFACT_INLINE auto blockTest(const TriangleBlock<L>& b, const RayPacket<1>& ray, float tFar, Packet<L>& e0,
@@ -316,7 +337,7 @@ struct TriangleIntersector {
         const Vec3<L> a(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
         const Vec3<L> bb(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
         const Vec3<L> c(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
-        return laneTest(a, bb, c, d, float(ray.tMin), tFar, e0, e1, e2, t);
+        return laneTest(a, bb, c, d, float(ray.tMin), tFar, e0, e1, e2, t, [&] { return blockNormal(b); });
     }
     // The lanes whose three edge functions agree in sign. A tolerance of 2^-16 of the
     // edge magnitudes closes vertices, where several near-zero spoke values of one fan
@@ -329,19 +350,21 @@ struct TriangleIntersector {
     // One ray against L triangles given relative to the ray origin (a, b, c): the same
     // watertight edge functions as the per-triangle test; the lanes hit in (tMin, tFar).
     // t is computed only when some lane is inside.
-    template <int L>
+    // normal() gives the triangles' normals (v1 - v0) x (v2 - v0) from the stored vertices.
+    template <int L, class Normal>
     static RTFACT_INLINE auto laneTest(const Vec3<L>& a, const Vec3<L>& b, const Vec3<L>& c, const Vec3<L>& d,
                                        float tMin, float tFar, Packet<L>& e0, Packet<L>& e1, Packet<L>& e2,
-                                       Packet<L>& t) {
+                                       Packet<L>& t, const Normal& normal) {
         using P = Packet<L>;
         e0 = dot(triangleEdge(b, c), d);
         e1 = dot(triangleEdge(c, a), d);
         e2 = dot(triangleEdge(a, b), d);
         const auto inside = edgesAgree(e0, e1, e2);
         if (none(inside)) return inside;
-        // The plane only once some lane is inside (most tests end above). Same values
-        // as the per-triangle test: n = (v1 - v0) x (v2 - v0).
-        const Vec3<L> nn = cross(b - a, c - a);
+        // The plane only once some lane is inside (most tests end above), with the
+        // per-triangle test's values: n from the stored (not origin-relative) vertices,
+        // so t matches it bit for bit, also for grazing rays where t is ill-conditioned.
+        const Vec3<L> nn = normal();
         const P nd = dot(nn, d);
         t = dot(nn, a) / nd;
         return inside & (nd != P(0.0f)) & (t > P(tMin)) & (t < P(tFar));

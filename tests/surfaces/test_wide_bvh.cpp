@@ -245,7 +245,8 @@ void checkTraversal(const std::vector<Elem>& elems, bool commonOrigin) {
                     }
                     ++hits;
                     ASSERT_GE(hit.id[i], 0) << "packet " << p << " lane " << i << " missed (brute t=" << bt << ")";
-                    EXPECT_NEAR(hit.t[i], bt, 1e-5f * std::max(1.0f, bt));
+                    EXPECT_NEAR(hit.t[i], bt, 1e-5f * std::max(1.0f, bt))
+                        << "packet " << p << " lane " << i << " id " << hit.id[i] << " brute id " << bid;
                 }
                 RayPacket<N> seg = rays;
                 for (int i = 0; i < N; ++i) seg.tMax[i] = 3.0f * u01(rng);
