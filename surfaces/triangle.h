@@ -41,6 +41,13 @@ RTFACT_INLINE V triangleEdge(const V& p, const V& q) {
     return cross(q - p, p + q);
 }
 
+// The (unnormalised) normal (v1 - v0) x (v2 - v0) every triangle test uses, of one
+// triangle (Vec3f) or of SIMD lanes of triangles (Vec3<L>).
+template <class V>
+RTFACT_INLINE V faceNormal(const V& v0, const V& v1, const V& v2) {
+    return cross(v1 - v0, v2 - v0);
+}
+
 // Up to L triangles in structure-of-arrays form (vertex, axis, lane) with their ids: the
 // leaf block of a BlockedWideBVH, tested with one SIMD edge-function test and no
 // gathers. Unused lanes repeat the last triangle (same id, same result).
@@ -154,7 +161,7 @@ struct TriangleIntersector {
         constexpr int W = Packet<N>::W;
         using P = Packet<W>;
         using PI = Packet<W, int32_t>;
-        const Vec3f n = cross(tri.v1 - tri.v0, tri.v2 - tri.v0);
+        const Vec3f n = faceNormal(tri.v0, tri.v1, tri.v2);
         const P zero(0.0f);
         // Lanes hit when the three edge functions agree in sign and t is in range. The
         // distance comes from the plane equation (tnum / dot(n, d)), not from the edge
@@ -209,20 +216,17 @@ struct TriangleIntersector {
         const Vec3<L> d(Vec3f(ray.dir.x[0], ray.dir.y[0], ray.dir.z[0]));
         for (int base = 0; base < count; base += L) {
             const int n = std::min(L, count - base);
+            auto tri = [&](int i) -> const Triangle& { return tris[base + std::min(i, n - 1)]; };  // pad: the last
             Vec3<L> a, b, c;
             for (int i = 0; i < L; ++i) {
-                const Triangle& t = tris[base + std::min(i, n - 1)];  // pad with the last one
-                a.setLane(i, t.v0 - of);
-                b.setLane(i, t.v1 - of);
-                c.setLane(i, t.v2 - of);
+                a.setLane(i, tri(i).v0 - of);
+                b.setLane(i, tri(i).v1 - of);
+                c.setLane(i, tri(i).v2 - of);
             }
             P e0, e1, e2, t;
             const auto m = laneTest(a, b, c, d, float(ray.tMin), float(hit.t), e0, e1, e2, t, [&] {
                 Vec3<L> nn;
-                for (int i = 0; i < L; ++i) {
-                    const Triangle& tri = tris[base + std::min(i, n - 1)];
-                    nn.setLane(i, cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
-                }
+                for (int i = 0; i < L; ++i) nn.setLane(i, faceNormal(tri(i).v0, tri(i).v1, tri(i).v2));
                 return nn;
             });
             if (!none(m)) takeNearest<D>(m, t, e0, e1, e2, ids + base, hit);
@@ -317,16 +321,16 @@ struct TriangleIntersector {
             for (int j = 0; j < 3; ++j)
                 w[j] = Vec3<L2>(pairLoad<L>(a.v[j][0], b.v[j][0]), pairLoad<L>(a.v[j][1], b.v[j][1]),
                                 pairLoad<L>(a.v[j][2], b.v[j][2]));
-            return cross(w[1] - w[0], w[2] - w[0]);
+            return faceNormal(w[0], w[1], w[2]);
         });
     }
-    // The normals (v1 - v0) x (v2 - v0) of a block's triangles.
+    // The normals of a block's triangles, from the stored vertices.
     template <int L>
     static RTFACT_INLINE Vec3<L> blockNormal(const TriangleBlock<L>& b) {
         using P = Packet<L>;
         Vec3<L> w[3];
         for (int j = 0; j < 3; ++j) w[j] = Vec3<L>(P::load(b.v[j][0]), P::load(b.v[j][1]), P::load(b.v[j][2]));
-        return cross(w[1] - w[0], w[2] - w[0]);
+        return faceNormal(w[0], w[1], w[2]);
     }
     template <int L>
     static RTFACT_INLINE auto blockTest(const TriangleBlock<L>& b, const RayPacket<1>& ray, float tFar, Packet<L>& e0,
@@ -350,7 +354,7 @@ struct TriangleIntersector {
     // One ray against L triangles given relative to the ray origin (a, b, c): the same
     // watertight edge functions as the per-triangle test; the lanes hit in (tMin, tFar).
     // t is computed only when some lane is inside.
-    // normal() gives the triangles' normals (v1 - v0) x (v2 - v0) from the stored vertices.
+    // normal() gives the triangles' faceNormal from the stored vertices.
     template <int L, class Normal>
     static RTFACT_INLINE auto laneTest(const Vec3<L>& a, const Vec3<L>& b, const Vec3<L>& c, const Vec3<L>& d,
                                        float tMin, float tFar, Packet<L>& e0, Packet<L>& e1, Packet<L>& e2,

@@ -19,19 +19,14 @@ namespace rtfact::volume {
 // register, which GCC 12 reports as uninitialized (-Werror in CI); same instructions.
 inline constexpr __mmask16 kAll16 = 0xFFFF;
 inline constexpr __mmask8 kAll8 = 0xFF;
-// The two 8-lane halves of 16 indices (a plain shuffle: the cast intrinsic has the same
-// undefined-source problem).
-RTFACT_INLINE __m256i lowHalf(simd::nvec<int32_t, 16> v) {
-    return (__m256i)__builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7);
-}
-RTFACT_INLINE __m256i highHalf(simd::nvec<int32_t, 16> v) {
-    return (__m256i)__builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15);
-}
+// The two 8-lane halves of 16 indices, as intrinsic operands.
+RTFACT_INLINE __m256i lowHalf(simd::nvec<int32_t, 16> v) { return (__m256i)simd::lowHalf<16>(v); }
+RTFACT_INLINE __m256i highHalf(simd::nvec<int32_t, 16> v) { return (__m256i)simd::highHalf<16>(v); }
 #endif
 
 #if RTFACT_NATIVE_WIDTH == 8
-RTFACT_INLINE __m128i lowHalf8(simd::nvec<int32_t, 8> v) { return _mm256_castsi256_si128((__m256i)v); }
-RTFACT_INLINE __m128i highHalf8(simd::nvec<int32_t, 8> v) { return _mm256_extracti128_si256((__m256i)v, 1); }
+RTFACT_INLINE __m128i lowHalf8(simd::nvec<int32_t, 8> v) { return (__m128i)simd::lowHalf<8>(v); }
+RTFACT_INLINE __m128i highHalf8(simd::nvec<int32_t, 8> v) { return (__m128i)simd::highHalf<8>(v); }
 // Four (even, odd) float pairs from each of two 64-bit gathers -> the even and the odd floats.
 RTFACT_INLINE void splitPairs8(__m256 lo, __m256 hi, simd::nvec<float, 8>& even, simd::nvec<float, 8>& odd) {
     const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);

@@ -393,16 +393,17 @@ template <size_t Off, size_t... I>
 constexpr auto offsetSeq(std::index_sequence<I...>) {
     return std::index_sequence<(I + Off)...>{};
 }
-// Lanes [0, W/2) and [W/2, W) of a W-lane vector, as W/2-lane vectors.
+}  // namespace detail
+// Lanes [0, W/2) and [W/2, W) of a W-lane vector, as W/2-lane vectors (plain shuffles:
+// the cast intrinsics start from an undefined register, which GCC 12 reports).
 template <int W, class V>
 RTFACT_INLINE auto lowHalf(V a) {
-    return shuffleLanes(a, std::make_index_sequence<W / 2>{});
+    return detail::shuffleLanes(a, std::make_index_sequence<W / 2>{});
 }
 template <int W, class V>
 RTFACT_INLINE auto highHalf(V a) {
-    return shuffleLanes(a, offsetSeq<W / 2>(std::make_index_sequence<W / 2>{}));
+    return detail::shuffleLanes(a, detail::offsetSeq<W / 2>(std::make_index_sequence<W / 2>{}));
 }
-}  // namespace detail
 
 // Horizontal min/max: halves folded with one vector min per level (log2 W dependent
 // steps, not W - 1); the last four lanes one by one. Same result as a lane-by-lane scan
@@ -412,7 +413,7 @@ RTFACT_INLINE auto hmin(V a) {
     if constexpr (W == 1)
         return a;
     else if constexpr (W > 4)
-        return hmin<W / 2>(vmin<W / 2>(detail::lowHalf<W>(a), detail::highHalf<W>(a)));
+        return hmin<W / 2>(vmin<W / 2>(lowHalf<W>(a), highHalf<W>(a)));
     else {
         auto r = a[0];
         for (int i = 1; i < W; ++i) r = a[i] < r ? a[i] : r;
@@ -424,7 +425,7 @@ RTFACT_INLINE auto hmax(V a) {
     if constexpr (W == 1)
         return a;
     else if constexpr (W > 4)
-        return hmax<W / 2>(vmax<W / 2>(detail::lowHalf<W>(a), detail::highHalf<W>(a)));
+        return hmax<W / 2>(vmax<W / 2>(lowHalf<W>(a), highHalf<W>(a)));
     else {
         auto r = a[0];
         for (int i = 1; i < W; ++i) r = a[i] > r ? a[i] : r;
