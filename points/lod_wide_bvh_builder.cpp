@@ -1,5 +1,6 @@
 // buildLoDWideBVH: see lod_wide_bvh.h.
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <array>
 #include <limits>
@@ -52,8 +53,8 @@ Sum leafBlock(LoDWideBVH& t, uint32_t first, uint32_t n) {
 struct Plan {
     int parts = 1;
     uint32_t first[K] = {0}, count[K] = {0};
-    int split[K - 1];  // part halved by each step, in order
-    uint32_t half[K - 1];
+    int steps = 0;
+    uint32_t stepFirst[K - 1], stepCount[K - 1], half[K - 1];  // range halved by each step, and where
 };
 Plan makePlan(uint32_t count) {
     Plan p;
@@ -66,12 +67,14 @@ Plan makePlan(uint32_t count) {
             if (p.count[i] > cap && (best < 0 || p.count[i] > p.count[best])) best = i;
         if (best < 0) break;
         const uint32_t h = uint32_t((p.count[best] + cap - 1) / cap / 2 * cap);
+        p.stepFirst[step] = p.first[best];
+        p.stepCount[step] = p.count[best];
+        p.half[step] = h;
         for (int i = p.parts; i > best + 1; --i) p.first[i] = p.first[i - 1], p.count[i] = p.count[i - 1];
         p.first[best + 1] = p.first[best] + h;
         p.count[best + 1] = p.count[best] - h;
         p.count[best] = h;
-        p.split[step] = best;
-        p.half[step] = h;
+        p.steps = step + 1;
         ++p.parts;
     }
     return p;
@@ -97,6 +100,38 @@ struct Ctx {
     NodeCounts* counts;  // read only during the build (every count was seen up front)
 };
 
+// The plan step that halves [f, f + c), or -1 when that range is one of the parts.
+int planStep(const Plan& p, uint32_t f, uint32_t c) {
+    for (int s = 0; s < p.steps; ++s)
+        if (p.stepFirst[s] == f && p.stepCount[s] == c) return s;
+    return -1;
+}
+
+// Applies the plan's steps inside d[f, f + c) (bounds of its centres: `box`), storing
+// each final part's cell. Sibling ranges are disjoint, so the discs end in the same
+// order as a serial replay of the steps.
+void splitRange(const Plan& p, Disc* d, uint32_t f, uint32_t c, const AABB& box, AABB* cell) {
+    const int s = planStep(p, f, c);
+    if (s < 0) {
+        for (int i = 0; i < p.parts; ++i)
+            if (p.first[i] == f) cell[i] = box;
+        return;
+    }
+    const uint32_t h = p.half[s];
+    const int axis = box.maxAxis();
+    selectMedianByCoordinate(d + f, c, h, axis);
+    AABB lo = box, hi = box;
+    lo.hi[axis] = hi.lo[axis] = d[f + h].center[axis];
+    auto left = [&] { splitRange(p, d, f, h, lo, cell); };
+    auto right = [&] { splitRange(p, d, f + h, c - h, hi, cell); };
+    if (c >= (1u << 18)) {
+        tbb::parallel_invoke(left, right);
+    } else {
+        left();
+        right();
+    }
+}
+
 // Node `ni` over elems[first, first + count) (cell: bounds of the centres): median splits
 // of the longest cell axis as planned, children built (the large ones in parallel), their
 // boxes and representatives stored in the node; returns the node's sum. Subtrees take
@@ -105,25 +140,10 @@ Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, const AABB&
     LoDWideBVH& t = *ctx.t;
     RTFACT_ASSERT(depth < LoDWideBVH::kMaxDepth, "wide LoD tree deeper than its traversal stack");
     const Plan p = makePlan(count);
-    // Replay the plan on the discs: each step selects the median of one part.
+    // Replay the plan on the discs: each step selects the median of one range; the
+    // halves of a step are independent, so large ones are split in parallel.
     AABB cell[K];
-    uint32_t pf[K] = {0}, pc[K] = {count};
-    cell[0] = rootCell;
-    Disc* d = t.elems.data() + first;
-    for (int step = 0, parts = 1; parts < p.parts; ++step, ++parts) {
-        const int b = p.split[step];
-        const uint32_t h = p.half[step];
-        const int axis = cell[b].maxAxis();
-        selectMedianByCoordinate(d + pf[b], pc[b], h, axis);
-        const float split = d[pf[b] + h].center[axis];
-        for (int i = parts; i > b + 1; --i) cell[i] = cell[i - 1], pf[i] = pf[i - 1], pc[i] = pc[i - 1];
-        cell[b + 1] = cell[b];
-        cell[b].hi[axis] = split;
-        cell[b + 1].lo[axis] = split;
-        pf[b + 1] = pf[b] + h;
-        pc[b + 1] = pc[b] - h;
-        pc[b] = h;
-    }
+    splitRange(p, t.elems.data() + first, 0, count, rootCell, cell);
     // Slots: children's subtrees follow this node in part order.
     uint32_t slot[K];
     uint32_t next = ni + 1;

@@ -623,10 +623,11 @@ RepHitStats checkWideRepresentativeHits(const PointScene& scene, bool commonOrig
 // of the child's subtree, the SoA copy in the parent matches it, its level is the
 // subtree's height, and empty slots are never cut.
 // The median build splits into complete subtrees and one rest: every node is full but at
-// most one per level (the rest's), so the tree has about one node per K-1 blocks.
+// most one per level (the rest's), so the tree has about one node per K-1 blocks. 600000
+// discs take the parallel median splits inside a node (ranges of 2^18 and more).
 TEST(DiscWideBVHMedian, NodesAreFullButOnePerLevel) {
     constexpr int K = DiscWideBVH::arity;
-    for (int n : {129, 5000, 40000}) {
+    for (int n : {129, 5000, 40000, 600000}) {
         SCOPED_TRACE(n);
         const LoDWideBVH w = buildLoDWideBVH(randomDiscs(n, 51 + uint32_t(n)), LoDWideSplit::Median);
         std::vector<int> partialPerLevel;
@@ -647,6 +648,19 @@ TEST(DiscWideBVHMedian, NodesAreFullButOnePerLevel) {
         for (size_t l = 0; l < partialPerLevel.size(); ++l) EXPECT_LE(partialPerLevel[l], 1) << "level " << l;
         EXPECT_LE(w.nodes.size(), w.blocks.size() / (K - 1) + partialPerLevel.size() + 1);
     }
+}
+
+// The parallel splits work on disjoint ranges, so the build does not depend on how the
+// tasks were scheduled: two builds of 600000 discs order them identically.
+TEST(DiscWideBVHMedian, ParallelBuildIsDeterministic) {
+    const std::vector<Disc> discs = randomDiscs(600000, 7);
+    const LoDWideBVH a = buildLoDWideBVH(discs, LoDWideSplit::Median), b = buildLoDWideBVH(discs, LoDWideSplit::Median);
+    ASSERT_EQ(a.elems.size(), b.elems.size());
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < a.elems.size(); ++i)
+        differ += a.elems[i].center != b.elems[i].center || a.elems[i].radius != b.elems[i].radius;
+    EXPECT_EQ(differ, 0u);
 }
 
 TEST_P(DiscWideBVHSplit, ChildRepresentativesCoverTheirSubtrees) {
