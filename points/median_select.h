@@ -1,10 +1,14 @@
 // selectByCoordinate: nth_element of discs by one centre coordinate, branch-free for
 // large ranges (the LoD builders' median splits).
 #pragma once
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <vector>
 
+#include "core/util/assert.h"
 #include "points/disc.h"
 
 namespace rtfact::points {
@@ -24,6 +28,57 @@ inline size_t partitionBelow(Disc* d, size_t n, int axis, float pivot) {
     return j;
 }
 
+// partitionBelow on several threads: chunks of `chunk` discs are partitioned on their
+// own, then the discs at or above the pivot that lie before the split j trade places with
+// those below it that lie after j, paired by rank (the k-th misplaced high one with the
+// k-th misplaced low one). The order depends on the chunk size only, not on the threads.
+inline size_t partitionBelowParallel(Disc* d, size_t n, int axis, float pivot, size_t chunk = size_t(1) << 16) {
+    const size_t chunks = (n + chunk - 1) / chunk;
+    std::vector<size_t> below(chunks);
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        const size_t b = c * chunk, e = std::min(n, b + chunk);
+        below[c] = partitionBelow(d + b, e - b, axis, pivot);
+    });
+    size_t j = 0;
+    for (size_t x : below) j += x;
+    // Runs of misplaced discs in position order, and the rank each run starts at.
+    struct Run {
+        size_t start, len, rank;
+    };
+    std::vector<Run> highs, lows;
+    size_t nh = 0, nl = 0;
+    for (size_t c = 0; c < chunks; ++c) {
+        const size_t b = c * chunk, e = std::min(n, b + chunk), m = b + below[c];
+        if (std::min(e, j) > m) {  // high ones in [m, e) before j
+            highs.push_back({m, std::min(e, j) - m, nh});
+            nh += highs.back().len;
+        }
+        if (m > std::max(b, j)) {  // low ones in [b, m) after j
+            lows.push_back({std::max(b, j), m - std::max(b, j), nl});
+            nl += lows.back().len;
+        }
+    }
+    RTFACT_ASSERT(nh == nl, "partition: misplaced counts differ");
+    auto runAt = [](const std::vector<Run>& runs, size_t rank) {
+        return std::upper_bound(runs.begin(), runs.end(), rank, [](size_t r, const Run& x) { return r < x.rank; }) - 1;
+    };
+    tbb::parallel_for(size_t(0), (nh + chunk - 1) / chunk, [&](size_t t) {
+        const size_t r0 = t * chunk, r1 = std::min(nh, r0 + chunk);
+        auto h = runAt(highs, r0), l = runAt(lows, r0);
+        size_t hi = r0 - h->rank, li = r0 - l->rank;
+        for (size_t r = r0; r < r1; ++r) {
+            if (hi == h->len) ++h, hi = 0;
+            if (li == l->len) ++l, li = 0;
+            std::swap(d[h->start + hi++], d[l->start + li++]);
+        }
+    });
+    return j;
+}
+
+// Ranges from this size on are partitioned on several threads (the root of a LoD build:
+// before the first split nothing else can run).
+constexpr size_t kParallelPartition = size_t(1) << 20;
+
 // nth_element by coordinate with the postcondition of std::nth_element. Each round sorts
 // a stratified sample and takes two pivots about sqrt(samples) sample ranks either side
 // of the target's estimated rank (Floyd-Rivest style): one branch-free pass moves what is
@@ -41,7 +96,8 @@ inline void selectByCoordinate(Disc* d, size_t n, size_t k, int axis) {
         std::sort(sample, sample + samples);
         const size_t t = k * samples / n, delta = size_t(std::sqrt(double(samples)));
         const float lo = sample[t > delta ? t - delta : 0], hi = sample[std::min(samples - 1, t + delta)];
-        const size_t j1 = partitionBelow(d, n, axis, lo);
+        const size_t j1 =
+            n >= kParallelPartition ? partitionBelowParallel(d, n, axis, lo) : partitionBelow(d, n, axis, lo);
         if (k < j1) {
             n = j1;
             continue;
@@ -49,7 +105,8 @@ inline void selectByCoordinate(Disc* d, size_t n, size_t k, int axis) {
         d += j1;
         k -= j1;
         n -= j1;
-        const size_t j2 = partitionBelow(d, n, axis, hi);
+        const size_t j2 =
+            n >= kParallelPartition ? partitionBelowParallel(d, n, axis, hi) : partitionBelow(d, n, axis, hi);
         if (k < j2) {
             n = j2;
         } else if (j2 > 0) {

@@ -388,17 +388,47 @@ TEST(LoDTree, SplitsAtTheMedianWithDistinctAndTiedCoordinates) {
     checkMedianSplits(same, 4);
 }
 
+// The parallel partition against the serial one: the same split point, everything below
+// the pivot before it and nothing below after it, the same multiset of discs; with small
+// chunks (so that misplaced runs span chunks and ranks) and ties, and its order
+// independent of the threads (same result twice).
+TEST(LoDTree, ParallelPartitionMatchesSerial) {
+    for (int n : {1, 999, 100000})
+        for (size_t chunk : {size_t(1), size_t(7), size_t(1000)})
+            for (float pivot : {0.0f, 0.3f, 0.5f, 2.0f}) {
+                std::vector<Disc> d = randomDiscs(n, uint32_t(n) + 3);
+                for (size_t i = 0; i < d.size(); i += 5) d[i].center.x = 0.5f;  // ties at the pivot
+                std::vector<Disc> a = d, b = d, c = d;
+                const size_t j = partitionBelow(a.data(), a.size(), 0, pivot);
+                ASSERT_EQ(partitionBelowParallel(b.data(), b.size(), 0, pivot, chunk), j) << n << " " << chunk;
+                ASSERT_EQ(partitionBelowParallel(c.data(), c.size(), 0, pivot, chunk), j);
+                for (size_t i = 0; i < b.size(); ++i) {
+                    ASSERT_EQ(b[i].center.x < pivot, i < j) << n << " " << chunk << " at " << i;
+                    ASSERT_EQ(b[i].center, c[i].center);
+                }
+                auto key = [](const Disc& x) { return std::tuple(x.center.x, x.center.y, x.center.z, x.rgba); };
+                std::vector<std::tuple<float, float, float, uint32_t>> kb, kd;
+                for (size_t i = 0; i < b.size(); ++i) kb.push_back(key(b[i])), kd.push_back(key(d[i]));
+                std::sort(kb.begin(), kb.end());
+                std::sort(kd.begin(), kd.end());
+                ASSERT_EQ(kb, kd);
+            }
+}
+
 // The selection against std::nth_element: the k-th coordinate at k, nothing greater
 // before it, nothing smaller after it; the same multiset of discs; with distinct,
 // tied (few values) and all-equal coordinates, at every size class.
 TEST(LoDTree, SelectByCoordinateMatchesNthElement) {
     std::mt19937 rng(45);
-    for (int n : {1, 2, 13, 25, 100, 1000, 5000, 70000})
+    for (int n : {1, 2, 13, 25, 100, 1000, 5000, 70000, int(kParallelPartition) + 4321})
         for (int ties : {0, 3, 1}) {
+            if (n > 70000 && ties == 3)
+                continue;  // (time) above the parallel threshold: the median, distinct and all-equal
             std::vector<Disc> d = randomDiscs(n, uint32_t(n + ties));
             if (ties > 0)
                 for (Disc& x : d) x.center.y = float(rng() % uint32_t(ties));
             for (size_t k : {size_t(0), size_t(n / 2), size_t(n - 1)}) {
+                if (n > 70000 && k != size_t(n / 2)) continue;
                 std::vector<Disc> a = d;
                 selectByCoordinate(a.data(), a.size(), k, 1);
                 std::vector<float> want(d.size());
