@@ -169,7 +169,12 @@ BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& o
             for (int k = 0; k < BrickedVolume::kEdge; ++k)
                 for (int j = 0; j < BrickedVolume::kEdge; ++j)
                     for (int i = 0; i < BrickedVolume::kEdge; ++i, ++n) {
-                        float s = acc.getValue(m0 + openvdb::Coord(bx * 8 + i, by * 8 + j, bz * 8 + k));
+                        // clamped at the grid's far faces, as brickVolume does for a dense
+                        // grid: the brick's value range (which steers skipping and the step
+                        // length) then matches the dense brick's
+                        float s = acc.getValue(m0 + openvdb::Coord(std::min(bx * 8 + i, v.dims[0] - 1),
+                                                                   std::min(by * 8 + j, v.dims[1] - 1),
+                                                                   std::min(bz * 8 + k, v.dims[2] - 1)));
                         if (!std::isfinite(s)) s = 0.0f;
                         dst[n] = s;
                         lo = std::min(lo, s);

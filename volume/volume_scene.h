@@ -11,6 +11,7 @@
 #include "core/util/error.h"
 #include "volume/brick_volume.h"
 #include "volume/half_float.h"
+#include "volume/tf_range_extrema.h"
 #include "volume/transfer_function.h"
 #include "volume/volume_grid.h"
 
@@ -157,32 +158,39 @@ struct VolumeScene {
     AABB bounds() const { return {origin + boxLo * spacing, origin + boxHi * spacing}; }
 
    private:
-    // log2 of each brick's step multiple: the largest m <= maxStepMultiple whose m-step
-    // opacity 1 - (1 - a)^m stays <= adaptiveOpacity for every TF entry the brick's value
-    // range reaches. Bricks the TF leaves invisible keep m = 1, so that a march without
-    // skipping reaches the same sample positions as one that skips them.
+    // log2 of each brick's step multiple: the largest m <= maxStepMultiple for which one
+    // step of M = 2^m times the base step differs from M plain steps by at most eps =
+    // adaptiveOpacity, whatever samples the brick's value range gives. With the TF's
+    // opacities amin..amax over that range, M plain steps reach an opacity between
+    // 1 - (1 - amin)^M and 1 - (1 - amax)^M, as does the one long step, so the opacity
+    // error is at most their difference; the colour error is at most the colour range
+    // times the opacity 1 - (1 - amax)^M. Faint bricks (the earlier rule: every entry's
+    // M-step opacity <= eps) pass both, and so do homogeneous ones at any opacity, where
+    // the long step is exact. Bricks the TF leaves invisible keep m = 0, so that a march
+    // without skipping reaches the same sample positions as one that skips them.
     std::vector<int32_t> stepMultiples(const BrickedVolume& v) const {
         std::vector<int32_t> out(v.brickCount(), 0);
         const bool dvr = settings.mode == VolumeMode::DVR || settings.mode == VolumeMode::Shaded;
         if (!dvr || settings.maxStepMultiple < 2) return out;
-        // per multiple, prefix counts of table entries too opaque for it
-        std::vector<int32_t> tooOpaque[3];
-        for (int m = 1; m < 3 && (1 << m) <= settings.maxStepMultiple; ++m) {
-            const float limit = 1.0f - std::pow(1.0f - settings.adaptiveOpacity, 1.0f / float(1 << m));
-            tooOpaque[m].assign(size_t(tf.size) + 1, 0);
-            for (int e = 0; e < tf.size; ++e)
-                tooOpaque[m][size_t(e) + 1] = tooOpaque[m][size_t(e)] + (tf.a[size_t(e)] > limit ? 1 : 0);
-        }
+        const TFRangeExtrema extrema(tf);
+        const float eps = settings.adaptiveOpacity;
         for (size_t i = 0; i < out.size(); ++i) {
             const float lo = v.cellLo[i] * v.scale + v.offset, hi = v.cellHi[i] * v.scale + v.offset;
             if (!tf.visible(std::min(lo, hi), std::max(lo, hi))) continue;
             int i0 = tf.index(lo), i1 = tf.index(hi);
             if (i0 > i1) std::swap(i0, i1);
-            for (int m = 2; m >= 1; --m)
-                if (!tooOpaque[m].empty() && tooOpaque[m][size_t(i1) + 1] == tooOpaque[m][size_t(i0)]) {
+            const TFRangeExtrema::Extrema e = extrema.range(i0, i1);
+            const float amin = std::min(e.lo[3], 1.0f), amax = std::min(e.hi[3], 1.0f);
+            const float dc = std::max({e.hi[0] - e.lo[0], e.hi[1] - e.lo[1], e.hi[2] - e.lo[2]});
+            for (int m = 2; m >= 1; --m) {
+                const float M = float(1 << m);
+                if ((1 << m) > settings.maxStepMultiple) continue;
+                const float tmin = std::pow(1.0f - amin, M), tmax = std::pow(1.0f - amax, M);
+                if (tmin - tmax <= eps && dc * (1.0f - tmax) <= eps) {
                     out[i] = m;
                     break;
                 }
+            }
         }
         return out;
     }

@@ -1,9 +1,12 @@
 // Transfer functions: presets, interpolation, window/level, opacity correction, JSON.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "core/util/error.h"
+#include "volume/tf_range_extrema.h"
 #include "volume/transfer_function.h"
 
 using namespace rtfact;
@@ -105,4 +108,33 @@ TEST(TransferFunction, BadJsonGivesOneLineError) {
         }
     }
     EXPECT_THROW(loadTransferFunction("/nonexistent/tf.json"), Error);
+}
+
+// The sparse tables against brute force: every channel's minimum and maximum over random
+// entry ranges (single entries, whole table, power-of-two and odd lengths) of a table with
+// noisy channels, and of one whose size is not a power of two.
+TEST(TFRangeExtrema, MatchesBruteForce) {
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int size : {1, 7, 256, 4096}) {
+        TFTable t;
+        t.size = size;
+        for (auto* ch : {&t.r, &t.g, &t.b, &t.a}) {
+            ch->resize(size_t(size));
+            for (float& x : *ch) x = u(rng);
+        }
+        const TFRangeExtrema e(t);
+        const std::vector<float>* ch[4] = {&t.r, &t.g, &t.b, &t.a};
+        for (int it = 0; it < 500; ++it) {
+            int i0 = int(rng() % uint32_t(size)), i1 = int(rng() % uint32_t(size));
+            if (it == 0) i0 = 0, i1 = size - 1;
+            if (i0 > i1) std::swap(i0, i1);
+            const TFRangeExtrema::Extrema x = e.range(i0, i1);
+            for (size_t c = 0; c < 4; ++c) {
+                const auto b = ch[c]->begin();
+                ASSERT_EQ(x.lo[c], *std::min_element(b + i0, b + i1 + 1)) << size << " " << i0 << " " << i1;
+                ASSERT_EQ(x.hi[c], *std::max_element(b + i0, b + i1 + 1)) << size << " " << i0 << " " << i1;
+            }
+        }
+    }
 }
