@@ -188,6 +188,17 @@ struct VolumeIntegrator {
         P skipAcc(0.0f);
         Packet<W, int32_t> sampleCount(0);
 
+        // Where the ray leaves the cube of bricks within `reach` - 1 of brick c (1: brick c
+        // itself). The side follows inv's sign, so an axis the ray runs along (inv +-1e20)
+        // gives a far exit, not a near one.
+        auto cubeExit = [&](const I* c, const I& reach) {
+            P tExit(kInfinity);
+            for (int a = 0; a < 3; ++a) {
+                const I side = select(inv[a] > P(0.0f), c[a] + reach, c[a] + I(1) - reach);
+                tExit = min(tExit, (toFloat(side) * P(float(Scene::kCells)) - oi[a]) * inv[a]);
+            }
+            return tExit;
+        };
         while (any(alive)) {
             Vec3<W> p = clampToGrid<W>(s, oi + di * t);
             Mask<W> samp = alive;
@@ -213,18 +224,24 @@ struct VolumeIntegrator {
                     start = (info & I(Scene::kPoolMask)) * I(Scene::template kBrickStride<L>);
                     haveStart = true;
                     if (adaptive) {
-                        const I l = shiftRight<W>(info, 28) & I(3);
+                        I l = shiftRight<W>(info, 28) & I(3);
+                        if (any(l > I(0))) {
+                            // A long step stands for samples kf .. kf + m - 1, which must all
+                            // lie in this brick and before tFar: near either it shortens to the
+                            // samples left (a power of two), so it never carries the brick's
+                            // opacity into the next one or past the box (a data-parallel rank's
+                            // neighbour has those samples), and homogeneous bricks stay exact.
+                            const P tOut = min(cubeExit(c, I(1)), tFar);
+                            const P left = -floor(-((tOut - tNear) * invDt - P(0.5f))) - kf;
+                            l = select(left >= P(4.0f), l, select(left >= P(2.0f), min(l, I(1)), I(0)));
+                        }
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));
                         tfOffset = l * I(s.tf.size);
                     }
                     reach = info & I(0x7fffffff);
                 }
                 if (any(empty)) {
-                    P tExit(kInfinity);
-                    for (int a = 0; a < 3; ++a) {
-                        const I side = select(di[a] > P(0.0f), c[a] + reach, c[a] + I(1) - reach);
-                        tExit = min(tExit, (toFloat(side) * P(float(Scene::kCells)) - oi[a]) * inv[a]);
-                    }
+                    const P tExit = cubeExit(c, reach);
                     const P kk = max(-floor(-((tExit - tNear) * invDt - P(0.5f))), kf + P(1.0f));
                     const P tn = tNear + (kk + P(0.5f)) * dt;
                     skipAcc += select(empty, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));
