@@ -388,6 +388,17 @@ TEST(LoDTree, SplitsAtTheMedianWithDistinctAndTiedCoordinates) {
     checkMedianSplits(same, 4);
 }
 
+namespace {
+// The discs as a sorted list of (centre, colour): equal lists, the same multiset.
+std::vector<std::tuple<float, float, float, uint32_t>> sortedKeys(const std::vector<Disc>& d) {
+    std::vector<std::tuple<float, float, float, uint32_t>> k;
+    k.reserve(d.size());
+    for (const Disc& x : d) k.emplace_back(x.center.x, x.center.y, x.center.z, x.rgba);
+    std::sort(k.begin(), k.end());
+    return k;
+}
+}  // namespace
+
 // The parallel partition against the serial one: the same split point, everything below
 // the pivot before it and nothing below after it, the same multiset of discs; with small
 // chunks (so that misplaced runs span chunks and ranks) and ties, and its order
@@ -406,12 +417,7 @@ TEST(LoDTree, ParallelPartitionMatchesSerial) {
                     ASSERT_EQ(b[i].center.x < pivot, i < j) << n << " " << chunk << " at " << i;
                     ASSERT_EQ(b[i].center, c[i].center);
                 }
-                auto key = [](const Disc& x) { return std::tuple(x.center.x, x.center.y, x.center.z, x.rgba); };
-                std::vector<std::tuple<float, float, float, uint32_t>> kb, kd;
-                for (size_t i = 0; i < b.size(); ++i) kb.push_back(key(b[i])), kd.push_back(key(d[i]));
-                std::sort(kb.begin(), kb.end());
-                std::sort(kd.begin(), kd.end());
-                ASSERT_EQ(kb, kd);
+                ASSERT_EQ(sortedKeys(b), sortedKeys(d));
             }
 }
 
@@ -437,12 +443,7 @@ TEST(LoDTree, SelectByCoordinateMatchesNthElement) {
                 ASSERT_EQ(a[k].center.y, want[k]) << n << " " << ties << " " << k;
                 for (size_t i = 0; i < k; ++i) ASSERT_LE(a[i].center.y, a[k].center.y);
                 for (size_t i = k + 1; i < a.size(); ++i) ASSERT_GE(a[i].center.y, a[k].center.y);
-                auto key = [](const Disc& x) { return std::tuple(x.center.x, x.center.y, x.center.z, x.rgba); };
-                std::vector<std::tuple<float, float, float, uint32_t>> ka, kd;
-                for (size_t i = 0; i < a.size(); ++i) ka.push_back(key(a[i])), kd.push_back(key(d[i]));
-                std::sort(ka.begin(), ka.end());
-                std::sort(kd.begin(), kd.end());
-                ASSERT_EQ(ka, kd);
+                ASSERT_EQ(sortedKeys(a), sortedKeys(d));
             }
         }
 }
