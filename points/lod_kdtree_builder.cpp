@@ -6,6 +6,7 @@
 
 #include "core/util/error.h"
 #include "core/util/huge_pages.h"
+#include "points/centre_bounds.h"
 #include "points/lod_kdtree.h"
 #include "points/lod_rep.h"
 #include "points/median_select.h"
@@ -113,9 +114,7 @@ LoDKdTree LoDKdTreeBuilder::build(std::vector<Disc> discs) const {
     const uint32_t total = 1 + ctx.computeDesc(discs.size());
     resizeFreshHugePages(t.nodes, total);
     resizeFreshHugePages(t.inner, (total - 1) / 2);
-    AABB cell;
-    for (const Disc& d : discs) cell.extend(d.center);
-    const Agg a = buildNode(ctx, discs.data(), discs.size(), cell, 0, 1);
+    const Agg a = buildNode(ctx, discs.data(), discs.size(), centreBounds(discs), 0, 1);
     t.box = a.s.box;
     const Vec3f pad = Vec3f(1e-6f * (maxComponent(vmax(-a.s.box.lo, a.s.box.hi)) + maxComponent(a.s.box.extent())));
     t.box.lo -= pad;

@@ -1,7 +1,6 @@
 // buildLoDWideBVH: see lod_wide_bvh.h.
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
-#include <tbb/parallel_reduce.h>
 
 #include <array>
 #include <limits>
@@ -9,6 +8,7 @@
 #include "core/accel/wide_bvh_builder.h"
 #include "core/util/assert.h"
 #include "core/util/error.h"
+#include "points/centre_bounds.h"
 #include "points/lod_rep.h"
 #include "points/lod_wide_bvh.h"
 #include "points/median_select.h"
@@ -289,14 +289,7 @@ LoDWideBVH buildLoDWideBVH(std::vector<Disc> discs, LoDWideSplit split) {
     resizeFreshHugePages(t.childReps, nodes);
     resizeFreshHugePages(t.reps, size_t(nodes) * K);
     resizeHugePages(t.blocks, (n + S - 1) / S);
-    // bounds of the centres (in parallel: nothing else can run before the first split)
-    const AABB cell = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, n, size_t(1) << 16), AABB{},
-        [&](const tbb::blocked_range<size_t>& r, AABB box) {
-            for (size_t i = r.begin(); i < r.end(); ++i) box.extend(t.elems[i].center);
-            return box;
-        },
-        [](const AABB& a, const AABB& b) { return merge(a, b); });
+    const AABB cell = centreBounds(t.elems);
     Ctx ctx{&t, &counts};
     const Sum root = buildNode(ctx, 0, 0, n, cell, 0);
     t.box = root.s.box;

@@ -191,6 +191,8 @@ struct VolumeIntegrator {
         // Where the ray leaves the cube of bricks within `reach` - 1 of brick c (1: brick c
         // itself). The side follows inv's sign, so an axis the ray runs along (inv +-1e20)
         // gives a far exit, not a near one.
+        // Index of the first sample at or past distance tx.
+        auto sampleIndexAt = [&](const P& tx) { return -floor(-((tx - tNear) * invDt - P(0.5f))); };
         auto cubeExit = [&](const I* c, const I& reach) {
             P tExit(kInfinity);
             for (int a = 0; a < 3; ++a) {
@@ -232,7 +234,7 @@ struct VolumeIntegrator {
                             // opacity into the next one or past the box (a data-parallel rank's
                             // neighbour has those samples), and homogeneous bricks stay exact.
                             const P tOut = min(cubeExit(c, I(1)), tFar);
-                            const P left = -floor(-((tOut - tNear) * invDt - P(0.5f))) - kf;
+                            const P left = sampleIndexAt(tOut) - kf;
                             l = select(left >= P(4.0f), l, select(left >= P(2.0f), min(l, I(1)), I(0)));
                         }
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));
@@ -242,7 +244,7 @@ struct VolumeIntegrator {
                 }
                 if (any(empty)) {
                     const P tExit = cubeExit(c, reach);
-                    const P kk = max(-floor(-((tExit - tNear) * invDt - P(0.5f))), kf + P(1.0f));
+                    const P kk = max(sampleIndexAt(tExit), kf + P(1.0f));
                     const P tn = tNear + (kk + P(0.5f)) * dt;
                     skipAcc += select(empty, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));
                     kf = select(empty, kk, kf);
