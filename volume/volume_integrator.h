@@ -68,22 +68,25 @@ struct VolumeIntegrator {
         return r;
     }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
-    // `knownStart`: the brick's first entry (in layout L) when the caller looked it up.
     template <int W, VoxelLayout L = VoxelLayout::Rows, class Scene>
-    static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p,
-                                          const Packet<W, int32_t>* knownStart = nullptr) {
-        const bool haveStart = knownStart != nullptr;
+    static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p) {
+        using I = Packet<W, int32_t>;
+        static_assert(Scene::kCells == 8);
+        const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
+        const I start = gather(s.template entryStart<L>(), shiftRight<W>(cell[0], 3) + shiftRight<W>(cell[1], 3) * I(s.nbx) +
+                                                              shiftRight<W>(cell[2], 3) * I(s.nbxy));
+        return sampleCell<W, L>(s, p, cell, start);
+    }
+    // The same with the cell (toInt of p) and its brick's first entry (in layout L) known.
+    template <int W, VoxelLayout L, class Scene>
+    static RTFACT_INLINE Packet<W> sampleCell(const Scene& s, const Vec3<W>& p, const Packet<W, int32_t>* cell,
+                                              const Packet<W, int32_t>& start) {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
         constexpr int R = Scene::template kRowStride<L>, S = Scene::template kSliceStride<L>;
-        const I ix = toInt(p.x), iy = toInt(p.y), iz = toInt(p.z);
-        const P fx = p.x - toFloat(ix), fy = p.y - toFloat(iy), fz = p.z - toFloat(iz);
-        // brick of the cell, then the cell's first entry inside the brick
-        static_assert(Scene::kCells == 8);
-        const I bx = shiftRight<W>(ix, 3), by = shiftRight<W>(iy, 3), bz = shiftRight<W>(iz, 3);
-        const I start =
-            haveStart ? *knownStart : gather(s.template entryStart<L>(), bx + by * I(s.nbx) + bz * I(s.nbxy));
-        const I base = start + (ix - bx * I(8)) + (iy - by * I(8)) * I(R) + (iz - bz * I(8)) * I(S);
+        const P fx = p.x - toFloat(cell[0]), fy = p.y - toFloat(cell[1]), fz = p.z - toFloat(cell[2]);
+        // the cell's first entry inside its brick (8 cells a brick edge)
+        const I base = start + (cell[0] & I(7)) + (cell[1] & I(7)) * I(R) + (cell[2] & I(7)) * I(S);
         // rows (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1): a = x, b = x + 1
         P a0, b0, a1, b1, a2, b2, a3, b3;
         if constexpr (L == VoxelLayout::YPairs) {
@@ -156,7 +159,7 @@ struct VolumeIntegrator {
             tNear = max(tNear, min(t0, t1));
             tFar = min(tFar, max(t0, t1));
         }
-        const P dt(s.dt), invDt(1.0f / s.dt);
+        const P dt(s.dt), dt3(3.0f * s.dt), invDt(1.0f / s.dt);
         // Sample k sits at tNear + (k + 1/2) dt, computed directly (not accumulated) so
         // that skipping and stepping reach bit-identical positions.
         P kf(0.0f);
@@ -182,27 +185,39 @@ struct VolumeIntegrator {
         Mask<W> hasPrev(false);
         const P isoV(s.isoStored);
         const P term(s.settings.earlyTermination);
-        const float invCell = s.invCell;
         const I ncx(s.cells[0]), ncxy(s.cells[0] * s.cells[1]);
-        const I cellHi[3] = {I(s.cells[0] - 1), I(s.cells[1] - 1), I(s.cells[2] - 1)};
         P skipAcc(0.0f);
         Packet<W, int32_t> sampleCount(0);
 
+        // Per axis, once a ray: the side of a brick the ray leaves by follows inv's sign (an
+        // axis the ray runs along, inv +-1e20, gives a far exit, not a near one), and the
+        // exit distance of plane x is x kCells inv - oi inv.
+        Mask<W> up[3];
+        P invBrick[3], oiInv[3];
+        for (int a = 0; a < 3; ++a) {
+            up[a] = inv[a] > P(0.0f);
+            invBrick[a] = inv[a] * P(float(Scene::kCells));
+            oiInv[a] = oi[a] * inv[a];
+        }
         // Where the ray leaves the cube of bricks within `reach` - 1 of brick c (1: brick c
-        // itself). The side follows inv's sign, so an axis the ray runs along (inv +-1e20)
-        // gives a far exit, not a near one.
-        // Index of the first sample at or past distance tx.
-        auto sampleIndexAt = [&](const P& tx) { return -floor(-((tx - tNear) * invDt - P(0.5f))); };
-        auto cubeExit = [&](const I* c, const I& reach) {
+        // itself).
+        auto cubeExit = [&](const I* c, const I& reach) __attribute__((always_inline)) {
             P tExit(kInfinity);
             for (int a = 0; a < 3; ++a) {
-                const I side = select(inv[a] > P(0.0f), c[a] + reach, c[a] + I(1) - reach);
-                tExit = min(tExit, (toFloat(side) * P(float(Scene::kCells)) - oi[a]) * inv[a]);
+                const I side = c[a] + select(up[a], reach, I(1) - reach);
+                tExit = min(tExit, toFloat(side) * invBrick[a] - oiInv[a]);
             }
             return tExit;
         };
+        // Index of the first sample at or past distance tx.
+        auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) { return -floor(-((tx - tNear) * invDt - P(0.5f))); };
         while (any(alive)) {
-            Vec3<W> p = clampToGrid<W>(s, oi + di * t);
+            const Vec3<W> p = clampToGrid<W>(s, oi + di * t);
+            // the sample's cell, and its brick (p >= 0: floor(p / 8) = floor(p) / 8; p < dims - 1
+            // keeps the brick inside the brick grid)
+            static_assert(Scene::kCells == 8);
+            const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
+            const I c[3] = {shiftRight<W>(cell[0], 3), shiftRight<W>(cell[1], 3), shiftRight<W>(cell[2], 3)};
             Mask<W> samp = alive;
             I start(0);
             bool haveStart = false;
@@ -211,8 +226,6 @@ struct VolumeIntegrator {
             // Empty-space skipping: jump to the first sample position past the empty cube of
             // bricks around the lane's brick (one brick for MIP).
             {
-                I c[3];
-                for (int a = 0; a < 3; ++a) c[a] = min(toInt(p[a] * P(invCell)), cellHi[a]);
                 const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
                 Mask<W> empty;
                 I reach(1);  // empty cube radius + 1, in bricks
@@ -222,8 +235,12 @@ struct VolumeIntegrator {
                     // one gather gives the brick, its step multiple, or (sign bit) the
                     // distance to the nearest brick that is not skipped
                     const I info = gather(s.brickInfo.data(), cid);
-                    empty = alive & (info < I(0));
-                    start = (info & I(Scene::kPoolMask)) * I(Scene::template kBrickStride<L>);
+                    const Mask<W> skipped = info < I(0);
+                    empty = alive & skipped;
+                    // The gathers read every lane: a skipped brick's lanes read pool brick 0
+                    // (the shared zero brick), not the pool index its distance bits would give,
+                    // which lies past the pool of a sparse volume.
+                    start = select(skipped, I(0), (info & I(Scene::kPoolMask)) * I(Scene::template kBrickStride<L>));
                     haveStart = true;
                     if (adaptive) {
                         I l = shiftRight<W>(info, 28) & I(3);
@@ -233,9 +250,9 @@ struct VolumeIntegrator {
                             // samples left (a power of two), so it never carries the brick's
                             // opacity into the next one or past the box (a data-parallel rank's
                             // neighbour has those samples), and homogeneous bricks stay exact.
-                            const P tOut = min(cubeExit(c, I(1)), tFar);
-                            const P left = sampleIndexAt(tOut) - kf;
-                            l = select(left >= P(4.0f), l, select(left >= P(2.0f), min(l, I(1)), I(0)));
+                            // (samples kf + 1, kf + 3 lie dt, 3 dt past t)
+                            const P room = min(cubeExit(c, I(1)), tFar) - t;
+                            l = select(room > dt3, l, select(room > dt, min(l, I(1)), I(0)));
                         }
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));
                         tfOffset = l * I(s.tf.size);
@@ -255,7 +272,7 @@ struct VolumeIntegrator {
             if (any(samp)) {
                 sampleCount = sampleCount + select(samp, I(1), I(0));
                 // sampling lanes have not moved since the brick lookup; the others are masked
-                const P v = haveStart ? sample<W, L>(s, p, &start) : sample<W, L>(s, p);
+                const P v = haveStart ? sampleCell<W, L>(s, p, cell, start) : sample<W, L>(s, p);
                 if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
                     // the whole RGBA entry in one 64-bit gather per lane
                     P tr, tg, tb, ta;

@@ -90,7 +90,6 @@ struct VolumeScene {
     // one 64-bit gather fetches an entry.
     std::vector<uint64_t> rgbaSteps;
     std::vector<float> cellMax;
-    float invCell = 1.0f / kCells;
 
     VolumeScene(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& s) : settings(s), tf(table) {
         for (int a = 0; a < 3; ++a) {

@@ -120,25 +120,22 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
 #if RTFACT_NATIVE_WIDTH == 8
     if constexpr (W == 8) {
         if constexpr (sizeof(T) == 1) {
+            // bytes a0 a1 b0 b1 of each dword; the middle two zero-extended by one shuffle each
             const __m256i g = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 2);
-            const __m256i m = _mm256_set1_epi32(0xFF);
-            a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, m));
-            a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(g, 8), m));
-            b0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(g, 16), m));
+            const __m256i byte1 = _mm256_set1_epi32(int(0x80808001u)), byte2 = _mm256_set1_epi32(int(0x80808002u));
+            a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, _mm256_set1_epi32(0xFF)));
+            a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_shuffle_epi8(g, byte1));
+            b0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_shuffle_epi8(g, byte2));
             b1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(g, 24));
         } else {
-            const __m256 lo =
-                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, lowHalf8(idx.c[0]), 4));
-            const __m256 hi =
-                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, highHalf8(idx.c[0]), 4));
-            nvec<float, 8> pa, pb;  // (a0 | a1 << 16) and (b0 | b1 << 16) per lane
-            splitPairs8(lo, hi, pa, pb);
-            const __m256i ia = _mm256_castps_si256((__m256)pa), ib = _mm256_castps_si256((__m256)pb);
+            // entry idx and idx + 1 by two 32-bit gathers: no reordering of 64-bit elements
+            const __m256i ga = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 4);
+            const __m256i gb = _mm256_i32gather_epi32((const int*)base + 1, (__m256i)idx.c[0], 4);
             const __m256i m = _mm256_set1_epi32(0xFFFF);
-            a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(ia, m));
-            a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(ia, 16));
-            b0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(ib, m));
-            b1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(ib, 16));
+            a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(ga, m));
+            a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(ga, 16));
+            b0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(gb, m));
+            b1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(gb, 16));
         }
         return;
     }
@@ -150,10 +147,17 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
                 _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), kAll16, (__m512i)idx.c[0], (const void*)base, 2);
             const __m512i m = _mm512_set1_epi32(0xFF);
             a0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(g, m));
+#if defined(__AVX512BW__)
+            // the middle two bytes zero-extended by one shuffle each
+            const __m512i byte1 = _mm512_set1_epi32(int(0x80808001u)), byte2 = _mm512_set1_epi32(int(0x80808002u));
+            a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte1));
+            b0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte2));
+#else
             a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(
                 kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 8), m));
             b0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(
                 kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 16), m));
+#endif
             b1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_srli_epi32(kAll16, g, 24));
         } else {
             const __m512i lo =
