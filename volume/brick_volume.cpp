@@ -48,6 +48,8 @@ void BrickBuilder::init(BrickedVolume& v, const int dims[3], Storage s) {
     v.brickStart.assign(nbricks, 0);
     v.cellLo.assign(nbricks, 0.0f);
     v.cellHi.assign(nbricks, 0.0f);
+    v.subLo.assign(nbricks * 8, 0.0f);
+    v.subHi.assign(nbricks * 8, 0.0f);
     // brick 0: zeros, plus padding so wide gathers may over-read at the end
     v.pool.assign(size_t(BrickedVolume::kBrick) * size_t(storageBytes(s)), 0);
 }
@@ -154,7 +156,6 @@ void brickDense(VolumeGrid& g, BrickedVolume& v, bool release) {
                 v.brickStart[b] = int32_t(start[b]);
                 if (zero[b]) continue;
                 T* dst = pool + start[b];
-                float lo = std::numeric_limits<float>::infinity(), hi = -lo;
                 int n = 0;
                 for (int k = 0; k < BrickedVolume::kEdge; ++k) {
                     const int z = std::min(bz * BrickedVolume::kCells + k, g.dims[2] - 1);
@@ -164,13 +165,10 @@ void brickDense(VolumeGrid& g, BrickedVolume& v, bool release) {
                         for (int i = 0; i < BrickedVolume::kEdge; ++i, ++n) {
                             const T s = row[std::min(bx * BrickedVolume::kCells + i, g.dims[0] - 1)];
                             dst[n] = s;
-                            lo = std::min(lo, float(s));
-                            hi = std::max(hi, float(s));
                         }
                     }
                 }
-                v.cellLo[b] = lo;
-                v.cellHi[b] = hi;
+                setBrickRanges(v, b, dst);
             }
         });
     }

@@ -32,6 +32,11 @@ struct BrickedVolume {
     std::vector<uint8_t> pool;          // bricks of kBrick samples; brick 0 is all zero
     std::vector<int32_t> brickStart;    // per brick: first sample in the pool
     std::vector<float> cellLo, cellHi;  // per brick: stored min/max
+    // Per brick and octant (index b * 8 + ox + 2 oy + 4 oz): the stored min/max of the
+    // octant's 5^3 samples, everything a sample in its 4^3 cells reads: the finer grid of
+    // empty-space skipping. setBrickRanges fills both from a brick's samples.
+    static constexpr int kSubCells = kCells / 2;
+    std::vector<float> subLo, subHi;
     // u8/u16 only, a second copy of the pool for the march: y-pair rows. Pool brick b is
     // pair brick b of kPairEntries entries; entry (x, y, z), y < kCells, holds the samples
     // (x, y, z) and (x, y + 1, z), so one 32-bit (u8) or 64-bit (u16) load at (x, y, z)
@@ -51,7 +56,7 @@ struct BrickedVolume {
     size_t storedBricks() const { return pool.size() / (size_t(kBrick) * size_t(storageBytes(storage))) - 1; }
     size_t memoryBytes() const {
         return pool.capacity() + pairs.capacity() + brickStart.capacity() * 4 +
-               (cellLo.capacity() + cellHi.capacity()) * 4;
+               (cellLo.capacity() + cellHi.capacity() + subLo.capacity() + subHi.capacity()) * 4;
     }
     template <class T>
     const T* data() const {
@@ -84,6 +89,31 @@ struct BrickBuilder {
     static void finish(BrickedVolume& v);
 };
 
+// Sets brick b's value ranges (cellLo/cellHi and its octants' subLo/subHi) from its
+// kBrick samples s (x fastest).
+template <class T>
+void setBrickRanges(BrickedVolume& v, size_t b, const T* s) {
+    constexpr int E = BrickedVolume::kEdge, H = BrickedVolume::kSubCells;
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (int o = 0; o < 8; ++o) {
+        const int x0 = (o & 1) * H, y0 = (o >> 1 & 1) * H, z0 = (o >> 2) * H;
+        float olo = std::numeric_limits<float>::infinity(), ohi = -olo;
+        for (int k = z0; k <= z0 + H; ++k)
+            for (int j = y0; j <= y0 + H; ++j)
+                for (int i = x0; i <= x0 + H; ++i) {
+                    const float x = float(s[(k * E + j) * E + i]);
+                    olo = std::min(olo, x);
+                    ohi = std::max(ohi, x);
+                }
+        v.subLo[b * 8 + size_t(o)] = olo;
+        v.subHi[b * 8 + size_t(o)] = ohi;
+        lo = std::min(lo, olo);
+        hi = std::max(hi, ohi);
+    }
+    v.cellLo[b] = lo;
+    v.cellHi[b] = hi;
+}
+
 // Builds v.pairs from v.pool for u8/u16 volumes when the copy (1.78x the pool) is at most
 // 16 MB and the memory budget allows it (core/util/memory_budget.h), else leaves it
 // empty. Returns whether built.
@@ -94,7 +124,6 @@ void BrickBuilder::addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill) 
     const size_t bytes = size_t(BrickedVolume::kBrick) * size_t(storageBytes(v.storage));
     const size_t start = v.pool.size();
     v.pool.resize(start + bytes);
-    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
     uint8_t* dst = v.pool.data() + start;
     int n = 0;
     for (int k = 0; k < BrickedVolume::kEdge; ++k)
@@ -102,8 +131,6 @@ void BrickBuilder::addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill) 
             for (int i = 0; i < BrickedVolume::kEdge; ++i, ++n) {
                 const float s = fill(bx * BrickedVolume::kCells + i, by * BrickedVolume::kCells + j,
                                      bz * BrickedVolume::kCells + k);
-                lo = std::min(lo, s);
-                hi = std::max(hi, s);
                 if (v.storage == Storage::U8)
                     dst[n] = uint8_t(s);
                 else if (v.storage == Storage::U16)
@@ -113,8 +140,12 @@ void BrickBuilder::addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill) 
             }
     const size_t b = v.brickIndex(bx, by, bz);
     v.brickStart[b] = int32_t(start / size_t(storageBytes(v.storage)));
-    v.cellLo[b] = lo;
-    v.cellHi[b] = hi;
+    if (v.storage == Storage::U8)
+        setBrickRanges(v, b, dst);
+    else if (v.storage == Storage::U16)
+        setBrickRanges(v, b, reinterpret_cast<const uint16_t*>(dst));
+    else
+        setBrickRanges(v, b, reinterpret_cast<const float*>(dst));
 }
 
 }  // namespace rtfact::volume

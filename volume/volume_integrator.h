@@ -185,27 +185,29 @@ struct VolumeIntegrator {
         Mask<W> hasPrev(false);
         const P isoV(s.isoStored);
         const P term(s.settings.earlyTermination);
-        const I ncx(s.cells[0]), ncxy(s.cells[0] * s.cells[1]);
+        const I ncx(s.cells[0]), ncxy(s.cells[0] * s.cells[1]);  // brick grid (MIP)
+        const I nsx(s.subs[0]), nsxy(s.subs[0] * s.subs[1]);     // sub-brick grid
         P skipAcc(0.0f);
         Packet<W, int32_t> sampleCount(0);
 
         // Per axis, once a ray: the side of a brick the ray leaves by follows inv's sign (an
         // axis the ray runs along, inv +-1e20, gives a far exit, not a near one), and the
-        // exit distance of plane x is x kCells inv - oi inv.
+        // exit distance of plane x is x kCells inv - oi inv (sub-bricks: x kSub inv - oi inv).
         Mask<W> up[3];
-        P invBrick[3], oiInv[3];
+        P invBrick[3], invSub[3], oiInv[3];
         for (int a = 0; a < 3; ++a) {
             up[a] = inv[a] > P(0.0f);
             invBrick[a] = inv[a] * P(float(Scene::kCells));
+            invSub[a] = inv[a] * P(float(Scene::kSub));
             oiInv[a] = oi[a] * inv[a];
         }
-        // Where the ray leaves the cube of bricks within `reach` - 1 of brick c (1: brick c
-        // itself).
-        auto cubeExit = [&](const I* c, const I& reach) __attribute__((always_inline)) {
+        // Where the ray leaves the cube of cells of edge `size` (bricks: invBrick, sub-bricks:
+        // invSub) within `reach` - 1 of cell c (1: cell c itself).
+        auto cubeExit = [&](const I* c, const I& reach, const P* invSize) __attribute__((always_inline)) {
             P tExit(kInfinity);
             for (int a = 0; a < 3; ++a) {
                 const I side = c[a] + select(up[a], reach, I(1) - reach);
-                tExit = min(tExit, toFloat(side) * invBrick[a] - oiInv[a]);
+                tExit = min(tExit, toFloat(side) * invSize[a] - oiInv[a]);
             }
             return tExit;
         };
@@ -213,28 +215,34 @@ struct VolumeIntegrator {
         auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) { return -floor(-((tx - tNear) * invDt - P(0.5f))); };
         while (any(alive)) {
             const Vec3<W> p = clampToGrid<W>(s, oi + di * t);
-            // the sample's cell, and its brick (p >= 0: floor(p / 8) = floor(p) / 8; p < dims - 1
-            // keeps the brick inside the brick grid)
-            static_assert(Scene::kCells == 8);
+            // the sample's cell, its brick and sub-brick (p >= 0: floor(p / 8) = floor(p) / 8;
+            // p < dims - 1 keeps them inside their grids)
+            static_assert(Scene::kCells == 8 && Scene::kSub == 4);
             const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
             const I c[3] = {shiftRight<W>(cell[0], 3), shiftRight<W>(cell[1], 3), shiftRight<W>(cell[2], 3)};
+            const I sc[3] = {shiftRight<W>(cell[0], 2), shiftRight<W>(cell[1], 2), shiftRight<W>(cell[2], 2)};
             Mask<W> samp = alive;
             I start(0);
             bool haveStart = false;
             P mStep(1.0f);  // step multiple of the lanes' bricks (opacity-adaptive steps)
             I tfOffset(0);  // their TF table's first entry
             // Empty-space skipping: jump to the first sample position past the empty cube of
-            // bricks around the lane's brick (one brick for MIP).
+            // sub-bricks around the lane's sub-brick (one brick for MIP).
             {
-                const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
                 Mask<W> empty;
-                I reach(1);  // empty cube radius + 1, in bricks
+                I reach(1);  // empty cube radius + 1, in sub-bricks (MIP: bricks)
+                const P* cubeSize = invSub;
+                const I* cube = sc;
                 if (mode == VolumeMode::MIP) {
+                    const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
                     empty = alive & (gather(s.cellMax.data(), cid) <= maxv);
+                    cubeSize = invBrick;
+                    cube = c;
                 } else {
                     // one gather gives the brick, its step multiple, or (sign bit) the
-                    // distance to the nearest brick that is not skipped
-                    const I info = gather(s.brickInfo.data(), cid);
+                    // distance to the nearest sub-brick that is not skipped
+                    const I cid = select(alive, sc[0] + sc[1] * nsx + sc[2] * nsxy, I(0));
+                    const I info = gather(s.subInfo.data(), cid);
                     const Mask<W> skipped = info < I(0);
                     empty = alive & skipped;
                     // The gathers read every lane: a skipped brick's lanes read pool brick 0
@@ -251,7 +259,7 @@ struct VolumeIntegrator {
                             // opacity into the next one or past the box (a data-parallel rank's
                             // neighbour has those samples), and homogeneous bricks stay exact.
                             // (samples kf + 1, kf + 3 lie dt, 3 dt past t)
-                            const P room = min(cubeExit(c, I(1)), tFar) - t;
+                            const P room = min(cubeExit(c, I(1), invBrick), tFar) - t;
                             l = select(room > dt3, l, select(room > dt, min(l, I(1)), I(0)));
                         }
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));
@@ -260,7 +268,7 @@ struct VolumeIntegrator {
                     reach = info & I(0x7fffffff);
                 }
                 if (any(empty)) {
-                    const P tExit = cubeExit(c, reach);
+                    const P tExit = cubeExit(cube, reach, cubeSize);
                     const P kk = max(sampleIndexAt(tExit), kf + P(1.0f));
                     const P tn = tNear + (kk + P(0.5f)) * dt;
                     skipAcc += select(empty, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));

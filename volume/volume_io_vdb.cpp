@@ -164,7 +164,6 @@ BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& o
                       bz = int(b / (size_t(v.nb[0]) * size_t(v.nb[1])));
             const int32_t start = int32_t((li + 1) * size_t(BrickedVolume::kBrick));
             float* dst = pool + start;
-            float lo = std::numeric_limits<float>::infinity(), hi = -lo;
             int n = 0;
             for (int k = 0; k < BrickedVolume::kEdge; ++k)
                 for (int j = 0; j < BrickedVolume::kEdge; ++j)
@@ -177,12 +176,9 @@ BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& o
                                                                    std::min(bz * 8 + k, v.dims[2] - 1)));
                         if (!std::isfinite(s)) s = 0.0f;
                         dst[n] = s;
-                        lo = std::min(lo, s);
-                        hi = std::max(hi, s);
                     }
             v.brickStart[b] = start;
-            v.cellLo[b] = lo;
-            v.cellHi[b] = hi;
+            setBrickRanges(v, b, dst);
         }
     });
     return v;

@@ -76,14 +76,19 @@ struct VolumeScene {
     TFTable tf;
     float tfMul = 0, tfAdd = 0;
     float isoStored = 0;
-    // Bricks are the macrocells: flags (non-zero = may contribute) for DVR/iso, maxima for MIP.
-    int cells[3] = {0, 0, 0};
-    std::vector<int32_t> cellFlags;
-    // Per brick, one load for the march. Skipped (sign bit set): the low bits hold the
-    // Chebyshev distance in bricks to the nearest brick that is not skipped (>= 1), so a
-    // ray jumps the whole empty cube around it. Otherwise: pool brick (start / kBrick) in
-    // bits 0-27, log2 of the step multiple in bits 28-29.
-    std::vector<int32_t> brickInfo;
+    // Macrocells: for DVR, shaded and iso the sub-bricks (the bricks' octants, 4^3 cells:
+    // finer than bricks, so fewer invisible samples are marched where a brick is only partly
+    // visible) with flags (non-zero = may contribute); for MIP the bricks' maxima.
+    static constexpr int kSub = BrickedVolume::kSubCells;
+    int cells[3] = {0, 0, 0};  // bricks per axis
+    int subs[3] = {0, 0, 0};   // sub-bricks per axis (2 cells[a])
+    std::vector<int32_t> subFlags;
+    // Per sub-brick, one load for the march. Skipped (sign bit set): the low bits hold the
+    // Chebyshev distance in sub-bricks to the nearest one that is not skipped (>= 1), so a
+    // ray jumps the whole empty cube around it. Otherwise: its brick's pool brick (start /
+    // kBrick) in bits 0-27, log2 of the step multiple in bits 28-29 (the brick's; 0 where the
+    // TF hides the sub-brick, so that a march without skipping reaches the same samples).
+    std::vector<int32_t> subInfo;
     static constexpr int32_t kSkipBit = int32_t(0x80000000u), kPoolMask = (1 << 28) - 1, kMaxDistance = 16;
     // Transfer-function tables for 1, 2 and 4 steps (tf.size entries each): r, g, b and
     // the opacity 1 - (1 - a)^m of table m as four halves per entry (half_float.h), so that
@@ -96,6 +101,7 @@ struct VolumeScene {
             if (v.dims[a] < 2) throw Error("", "cannot render a volume with fewer than 2 voxels along an axis");
             dims[a] = v.dims[a];
             cells[a] = v.nb[a];
+            subs[a] = 2 * v.nb[a];
         }
         voxels = v.data<T>();
         brickStart = v.brickStart.data();
@@ -124,23 +130,34 @@ struct VolumeScene {
         tfAdd = (v.offset - tf.lo) * k + 0.5f;
         isoStored = (s.iso - v.offset) / v.scale;
         const size_t nc = v.brickCount();
-        cellFlags.resize(nc);
         cellMax = v.cellHi;
-        for (size_t i = 0; i < nc; ++i) {
-            const float lo = v.cellLo[i] * v.scale + v.offset, hi = v.cellHi[i] * v.scale + v.offset;
+        const size_t ns = nc * 8;
+        subFlags.resize(ns);
+        std::vector<uint8_t> visible(ns);
+        for (size_t i = 0; i < ns; ++i) {
+            const auto [b, o] = brickOctant(i);
             bool on = true;
-            if (s.mode == VolumeMode::DVR || s.mode == VolumeMode::Shaded)
+            if (s.mode == VolumeMode::DVR || s.mode == VolumeMode::Shaded) {
+                const float lo = v.subLo[b * 8 + o] * v.scale + v.offset, hi = v.subHi[b * 8 + o] * v.scale + v.offset;
                 on = tf.visible(std::min(lo, hi), std::max(lo, hi));
-            else if (s.mode == VolumeMode::Iso)
+            } else if (s.mode == VolumeMode::Iso) {
+                // Whole bricks: a ray may pass a sub-brick holding the crossing between two
+                // samples, and skipping the finer cells beyond widens the bracket over the
+                // surface's other side (the crossing is found from one sample on each side).
+                const float lo = v.cellLo[b] * v.scale + v.offset, hi = v.cellHi[b] * v.scale + v.offset;
                 on = std::min(lo, hi) <= s.iso && s.iso <= std::max(lo, hi);
-            cellFlags[i] = (on || !s.skipping) ? 1 : 0;
+            }
+            visible[i] = on ? 1 : 0;
+            subFlags[i] = (on || !s.skipping) ? 1 : 0;
         }
-        brickInfo.resize(nc);
+        subInfo.resize(ns);
         const std::vector<int32_t> multiple = stepMultiples(v);
         const std::vector<int32_t> dist = emptyDistance();
-        for (size_t i = 0; i < nc; ++i) {
-            if (v.brickStart[i] / kBrick > kPoolMask) throw Error("", "volume too large for the brick table");
-            brickInfo[i] = cellFlags[i] ? (v.brickStart[i] / kBrick) | (multiple[i] << 28) : (kSkipBit | dist[i]);
+        for (size_t i = 0; i < ns; ++i) {
+            const size_t b = brickOctant(i).first;
+            if (v.brickStart[b] / kBrick > kPoolMask) throw Error("", "volume too large for the brick table");
+            subInfo[i] = subFlags[i] ? (v.brickStart[b] / kBrick) | ((visible[i] ? multiple[b] : 0) << 28)
+                                     : (kSkipBit | dist[i]);
         }
         const size_t n = size_t(tf.size);
         rgbaSteps.resize(n * 3);
@@ -155,6 +172,14 @@ struct VolumeScene {
     }
 
     AABB bounds() const { return {origin + boxLo * spacing, origin + boxHi * spacing}; }
+
+    // Sub-brick i (x fastest over subs) as (brick, octant).
+    std::pair<size_t, size_t> brickOctant(size_t i) const {
+        const size_t sx = i % size_t(subs[0]), sy = i / size_t(subs[0]) % size_t(subs[1]),
+                     sz = i / (size_t(subs[0]) * size_t(subs[1]));
+        const size_t b = ((sz / 2) * size_t(cells[1]) + sy / 2) * size_t(cells[0]) + sx / 2;
+        return {b, (sx & 1) + 2 * (sy & 1) + 4 * (sz & 1)};
+    }
 
    private:
     // log2 of each brick's step multiple: the largest m <= maxStepMultiple for which one
@@ -193,18 +218,18 @@ struct VolumeScene {
         }
         return out;
     }
-    // Chebyshev distance (in bricks, capped at kMaxDistance) from each skipped brick to the
-    // nearest brick that is not: all bricks closer than that are skipped too. Grows the
+    // Chebyshev distance (in sub-bricks, capped at kMaxDistance) from each skipped sub-brick
+    // to the nearest one that is not: all sub-bricks closer than that are skipped too. Grows the
     // non-skipped set one brick per pass (separable 3x3x3 dilation).
     std::vector<int32_t> emptyDistance() const {
-        const int n[3] = {cells[0], cells[1], cells[2]};
+        const int n[3] = {subs[0], subs[1], subs[2]};
         const size_t nc = size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
         std::vector<int32_t> dist(nc, kMaxDistance);
         std::vector<uint8_t> reached(nc), tmp(nc);
         size_t left = 0;
         for (size_t i = 0; i < nc; ++i) {
-            reached[i] = cellFlags[i] ? 1 : 0;
-            if (cellFlags[i])
+            reached[i] = subFlags[i] ? 1 : 0;
+            if (subFlags[i])
                 dist[i] = 0;
             else
                 ++left;

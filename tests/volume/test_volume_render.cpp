@@ -3,6 +3,7 @@
 // image unchanged, and image regression of every mode on the shipped tooth CT.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -398,9 +399,9 @@ TEST(VolumeAdaptiveSteps, CloseToPlainMarchWithFewerSamples) {
     }
 }
 
-// The skipped bricks' distance map is the Chebyshev distance (in bricks, capped) to the
-// nearest brick that is not skipped, so a jump never passes over a visible brick; on a
-// sparse volume (two blobs in 12^3 bricks) the multi-brick jumps change no pixel.
+// The skipped sub-bricks' distance map is the Chebyshev distance (in sub-bricks, capped)
+// to the nearest one that is not skipped, so a jump never passes over a visible one; on a
+// sparse volume (two blobs in 12^3 bricks, 24^3 sub-bricks) the long jumps change no pixel.
 TEST(VolumeSkipping, DistanceMapIsChebyshevAndJumpsChangeNoPixel) {
     VolumeGrid g;
     g.dims[0] = g.dims[1] = g.dims[2] = 97;
@@ -416,24 +417,26 @@ TEST(VolumeSkipping, DistanceMapIsChebyshevAndJumpsChangeNoPixel) {
         R"({"colors":[[0,1,1,1],[1,1,1,1]],"opacity":[[0,0],[0.5,0],[0.6,0.3],[1,0.3]]})", "t");
     const BrickedVolume bv = brickVolume(g);
     const VolumeScene<uint8_t> s(bv, buildTable(tf, {0.0f, 255.0f}, 0.5f), {});
-    const int n = s.cells[0];
-    ASSERT_EQ(n, 12);
+    // the skipping grid: sub-bricks of 4^3 cells
+    const int n = s.subs[0];
+    ASSERT_EQ(n, 24);
+    std::vector<std::array<int, 3>> flagged;
+    for (int i = 0; i < n * n * n; ++i)
+        if (s.subFlags[size_t(i)]) flagged.push_back({i % n, i / n % n, i / (n * n)});
+    ASSERT_FALSE(flagged.empty());
     int far = 0;
     for (int z = 0; z < n; ++z)
         for (int y = 0; y < n; ++y)
             for (int x = 0; x < n; ++x) {
                 const size_t i = size_t(x + n * (y + n * z));
                 int best = VolumeScene<uint8_t>::kMaxDistance;
-                for (size_t o = 0; o < s.cellFlags.size(); ++o)
-                    if (s.cellFlags[o]) {
-                        const int ox = int(o) % n, oy = int(o) / n % n, oz = int(o) / (n * n);
-                        best = std::min(best, std::max({std::abs(ox - x), std::abs(oy - y), std::abs(oz - z)}));
-                    }
-                if (s.cellFlags[i]) {
-                    EXPECT_GE(s.brickInfo[i], 0);
+                for (const auto& o : flagged)
+                    best = std::min(best, std::max({std::abs(o[0] - x), std::abs(o[1] - y), std::abs(o[2] - z)}));
+                if (s.subFlags[i]) {
+                    EXPECT_GE(s.subInfo[i], 0);
                 } else {
-                    ASSERT_LT(s.brickInfo[i], 0);
-                    EXPECT_EQ(s.brickInfo[i] & 0x7fffffff, best) << x << "," << y << "," << z;
+                    ASSERT_LT(s.subInfo[i], 0);
+                    EXPECT_EQ(s.subInfo[i] & 0x7fffffff, best) << x << "," << y << "," << z;
                     far += best > 2;
                 }
             }
