@@ -73,8 +73,9 @@ struct VolumeIntegrator {
         using I = Packet<W, int32_t>;
         static_assert(Scene::kCells == 8);
         const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
-        const I start = gather(s.template entryStart<L>(), shiftRight<W>(cell[0], 3) + shiftRight<W>(cell[1], 3) * I(s.nbx) +
-                                                              shiftRight<W>(cell[2], 3) * I(s.nbxy));
+        const I start =
+            gather(s.template entryStart<L>(), shiftRight<W>(cell[0], 3) + shiftRight<W>(cell[1], 3) * I(s.nbx) +
+                                                   shiftRight<W>(cell[2], 3) * I(s.nbxy));
         return sampleCell<W, L>(s, p, cell, start);
     }
     // The same with the cell (toInt of p) and its brick's first entry (in layout L) known.
@@ -212,7 +213,9 @@ struct VolumeIntegrator {
             return tExit;
         };
         // Index of the first sample at or past distance tx.
-        auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) { return -floor(-((tx - tNear) * invDt - P(0.5f))); };
+        auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) {
+            return -floor(-((tx - tNear) * invDt - P(0.5f)));
+        };
         while (any(alive)) {
             const Vec3<W> p = clampToGrid<W>(s, oi + di * t);
             // the sample's cell, its brick and sub-brick (p >= 0: floor(p / 8) = floor(p) / 8;

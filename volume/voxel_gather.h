@@ -123,9 +123,9 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
             // bytes a0 a1 b0 b1 of each dword; the middle two zero-extended by one shuffle each
             const __m256i g = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 2);
             // (byte indices are within the 128-bit lane: dword k's byte b is 4k + b)
-            const __m256i byte1 = _mm256_setr_epi32(int(0x80808001u), int(0x80808005u), int(0x80808009u),
-                                                    int(0x8080800Du), int(0x80808001u), int(0x80808005u),
-                                                    int(0x80808009u), int(0x8080800Du));
+            const __m256i byte1 =
+                _mm256_setr_epi32(int(0x80808001u), int(0x80808005u), int(0x80808009u), int(0x8080800Du),
+                                  int(0x80808001u), int(0x80808005u), int(0x80808009u), int(0x8080800Du));
             const __m256i byte2 = _mm256_add_epi32(byte1, _mm256_set1_epi32(1));
             a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, _mm256_set1_epi32(0xFF)));
             a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_shuffle_epi8(g, byte1));
@@ -154,11 +154,13 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
 #if defined(__AVX512BW__)
             // the middle two bytes zero-extended by one shuffle each
             // (byte indices are within the 128-bit lane: dword k's byte b is 4k + b)
-            const __m512i byte1 = _mm512_set4_epi32(int(0x8080800Du), int(0x80808009u), int(0x80808005u),
-                                                    int(0x80808001u));
+            const __m512i byte1 =
+                _mm512_set4_epi32(int(0x8080800Du), int(0x80808009u), int(0x80808005u), int(0x80808001u));
             const __m512i byte2 = _mm512_add_epi32(byte1, _mm512_set1_epi32(1));
-            a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte1));
-            b0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte2));
+            a1.c[0] =
+                (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte1));
+            b0.c[0] =
+                (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte2));
 #else
             a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(
                 kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 8), m));
