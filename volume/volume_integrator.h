@@ -80,7 +80,7 @@ struct VolumeIntegrator {
     }
     // The same with the cell (toInt of p) and its brick's first entry (in layout L) known.
     template <int W, VoxelLayout L, class Scene>
-    static RTFACT_INLINE Packet<W> sampleCell(const Scene& s, const Vec3<W>& p, const Packet<W, int32_t>* cell,
+    static RTFACT_INLINE Packet<W> sampleCell(const Scene& s, const Vec3<W>& p, const Packet<W, int32_t> (&cell)[3],
                                               const Packet<W, int32_t>& start) {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
@@ -204,7 +204,7 @@ struct VolumeIntegrator {
         }
         // Where the ray leaves the cube of cells of edge `size` (bricks: invBrick, sub-bricks:
         // invSub) within `reach` - 1 of cell c (1: cell c itself).
-        auto cubeExit = [&](const I* c, const I& reach, const P* invSize) __attribute__((always_inline)) {
+        auto cubeExit = [&](const I(&c)[3], const I& reach, const P(&invSize)[3]) __attribute__((always_inline)) {
             P tExit(kInfinity);
             for (int a = 0; a < 3; ++a) {
                 const I side = c[a] + select(up[a], reach, I(1) - reach);
@@ -233,14 +233,11 @@ struct VolumeIntegrator {
             // sub-bricks around the lane's sub-brick (one brick for MIP).
             {
                 Mask<W> empty;
-                I reach(1);  // empty cube radius + 1, in sub-bricks (MIP: bricks)
-                const P* cubeSize = invSub;
-                const I* cube = sc;
+                P tExit;  // where the lanes' empty cube ends (computed when one is empty)
                 if (mode == VolumeMode::MIP) {
                     const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
                     empty = alive & (gather(s.cellMax.data(), cid) <= maxv);
-                    cubeSize = invBrick;
-                    cube = c;
+                    if (any(empty)) tExit = cubeExit(c, I(1), invBrick);
                 } else {
                     // one gather gives the brick, its step multiple, or (sign bit) the
                     // distance to the nearest sub-brick that is not skipped
@@ -268,10 +265,10 @@ struct VolumeIntegrator {
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));
                         tfOffset = l * I(s.tf.size);
                     }
-                    reach = info & I(0x7fffffff);
+                    // skipped: empty cube radius + 1, in sub-bricks
+                    if (any(empty)) tExit = cubeExit(sc, info & I(0x7fffffff), invSub);
                 }
                 if (any(empty)) {
-                    const P tExit = cubeExit(cube, reach, cubeSize);
                     const P kk = max(sampleIndexAt(tExit), kf + P(1.0f));
                     const P tn = tNear + (kk + P(0.5f)) * dt;
                     skipAcc += select(empty, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));

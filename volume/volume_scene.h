@@ -220,38 +220,62 @@ struct VolumeScene {
     }
     // Chebyshev distance (in sub-bricks, capped at kMaxDistance) from each skipped sub-brick
     // to the nearest one that is not: all sub-bricks closer than that are skipped too. Grows the
-    // non-skipped set one brick per pass (separable 3x3x3 dilation).
+    // non-skipped set one sub-brick per pass (separable 3x3x3 dilation).
     std::vector<int32_t> emptyDistance() const {
+        // The reached set as bits, 64 sub-bricks of an x row a word: one pass is a shift-or
+        // along x and an or of neighbouring rows along y and z (a 512^3 volume has 2M
+        // sub-bricks, too many for a byte a cell and pass when the TF changes interactively).
         const int n[3] = {subs[0], subs[1], subs[2]};
-        const size_t nc = size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
-        std::vector<int32_t> dist(nc, kMaxDistance);
-        std::vector<uint8_t> reached(nc), tmp(nc);
+        const size_t words = (size_t(n[0]) + 63) / 64, rows = size_t(n[1]) * size_t(n[2]);
+        const uint64_t lastMask = n[0] % 64 == 0 ? ~uint64_t(0) : (uint64_t(1) << (n[0] % 64)) - 1;
+        std::vector<int32_t> dist(size_t(n[0]) * rows, kMaxDistance);
+        std::vector<uint64_t> reached(words * rows, 0), prev;
         size_t left = 0;
-        for (size_t i = 0; i < nc; ++i) {
-            reached[i] = subFlags[i] ? 1 : 0;
-            if (subFlags[i])
-                dist[i] = 0;
-            else
-                ++left;
-        }
-        const size_t stride[3] = {1, size_t(n[0]), size_t(n[0]) * size_t(n[1])};
-        for (int d = 1; d < kMaxDistance && left > 0; ++d) {
-            for (int a = 0; a < 3; ++a) {
-                tmp = reached;
-                for (int z = 0; z < n[2]; ++z)
-                    for (int y = 0; y < n[1]; ++y)
-                        for (int x = 0; x < n[0]; ++x) {
-                            const int c[3] = {x, y, z};
-                            const size_t i = size_t(x) + size_t(y) * stride[1] + size_t(z) * stride[2];
-                            if ((c[a] > 0 && tmp[i - stride[a]]) || (c[a] + 1 < n[a] && tmp[i + stride[a]]))
-                                reached[i] = 1;
-                        }
-            }
-            for (size_t i = 0; i < nc; ++i)
-                if (reached[i] && dist[i] == kMaxDistance) {
-                    dist[i] = d;
-                    --left;
+        for (size_t r = 0; r < rows; ++r)
+            for (int x = 0; x < n[0]; ++x) {
+                const size_t i = r * size_t(n[0]) + size_t(x);
+                if (subFlags[i]) {
+                    reached[r * words + size_t(x) / 64] |= uint64_t(1) << (x % 64);
+                    dist[i] = 0;
+                } else {
+                    ++left;
                 }
+            }
+        for (int d = 1; d < kMaxDistance && left > 0; ++d) {
+            prev = reached;
+            // x: each bit ors in its two neighbours in the row
+            std::vector<uint64_t> cur(reached.size());
+            for (size_t r = 0; r < rows; ++r) {
+                const uint64_t* w = prev.data() + r * words;
+                for (size_t k = 0; k < words; ++k) {
+                    uint64_t v = w[k] | (w[k] << 1) | (w[k] >> 1);
+                    if (k > 0) v |= w[k - 1] >> 63;
+                    if (k + 1 < words) v |= w[k + 1] << 63;
+                    cur[r * words + k] = k + 1 == words ? v & lastMask : v;
+                }
+            }
+            // y, then z: each row ors in the rows beside it
+            for (int a = 1; a < 3; ++a) {
+                reached = cur;
+                const size_t step = a == 1 ? words : words * size_t(n[1]);
+                for (size_t r = 0; r < rows; ++r) {
+                    const int c = a == 1 ? int(r % size_t(n[1])) : int(r / size_t(n[1]));
+                    for (size_t k = 0; k < words; ++k) {
+                        const size_t i = r * words + k;
+                        uint64_t v = cur[i];
+                        if (c > 0) v |= cur[i - step];
+                        if (c + 1 < n[a]) v |= cur[i + step];
+                        reached[i] = v;
+                    }
+                }
+                if (a == 1) cur = reached;
+            }
+            for (size_t r = 0; r < rows; ++r)
+                for (size_t k = 0; k < words; ++k)
+                    for (uint64_t fresh = reached[r * words + k] & ~prev[r * words + k]; fresh; fresh &= fresh - 1) {
+                        dist[r * size_t(n[0]) + k * 64 + size_t(__builtin_ctzll(fresh))] = d;
+                        --left;
+                    }
         }
         return dist;
     }
