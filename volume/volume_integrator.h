@@ -132,10 +132,15 @@ struct VolumeIntegrator {
         const P c2 = c * c, c4 = c2 * c2, c8 = c4 * c4, c16 = c8 * c8;
         return select(g2 > P(1e-12f), P(0.2f) + P(0.8f) * c + P(0.25f) * c16 * c4, P(1.0f));
     }
+    // The TF table entry of stored values v, as a float (toInt gives the index).
+    template <int W, class Scene>
+    static RTFACT_INLINE Packet<W> tfEntry(const Scene& s, const Packet<W>& v) {
+        using P = Packet<W>;
+        return clamp(v * P(s.tfMul) + P(s.tfAdd), P(0.0f), P(float(s.tf.size - 1)));
+    }
     template <int W, class Scene>
     static RTFACT_INLINE Packet<W, int32_t> tfIndex(const Scene& s, const Packet<W>& v) {
-        using P = Packet<W>;
-        return toInt(clamp(v * P(s.tfMul) + P(s.tfAdd), P(0.0f), P(float(s.tf.size - 1))));
+        return toInt(tfEntry<W>(s, v));
     }
 
     template <int W, VoxelLayout L, class Scene>
@@ -282,20 +287,27 @@ struct VolumeIntegrator {
                 // sampling lanes have not moved since the brick lookup; the others are masked
                 const P v = haveStart ? sampleCell<W, L>(s, p, cell, start) : sample<W, L>(s, p);
                 if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
-                    // the whole RGBA entry in one 64-bit gather per lane
-                    P tr, tg, tb, ta;
-                    fetchRgbaHalf<W>(s.rgbaSteps.data(), tfIndex<W>(s, v) + tfOffset, tr, tg, tb, ta);
-                    const P a = select(samp, ta, P(0.0f));
-                    const Mask<W> contrib = a > P(0.0f);
-                    if (any(contrib)) {
-                        Vec3<W> c(tr, tg, tb);
-                        if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W, L>(s, p), d);
-                        const P w = (P(1.0f) - alpha) * a;
-                        col += c * w;
-                        alpha += w;
-                        depth = select(contrib & (depth == P(kInfinity)), t, depth);
+                    // TF entries outside [tfVisibleLo, tfVisibleHi) have zero opacity: when no
+                    // lane's entry is inside, the sample adds nothing (inside partly visible
+                    // sub-bricks most samples are invisible) and the TF fetch is left out.
+                    const P e = tfEntry<W>(s, v);
+                    const Mask<W> seen = samp & (e >= P(s.tfVisibleLo)) & (e < P(s.tfVisibleHi));
+                    if (any(seen)) {
+                        // the whole RGBA entry in one 64-bit gather per lane
+                        P tr, tg, tb, ta;
+                        fetchRgbaHalf<W>(s.rgbaSteps.data(), toInt(e) + tfOffset, tr, tg, tb, ta);
+                        const P a = select(seen, ta, P(0.0f));
+                        const Mask<W> contrib = a > P(0.0f);
+                        if (any(contrib)) {
+                            Vec3<W> c(tr, tg, tb);
+                            if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W, L>(s, p), d);
+                            const P w = (P(1.0f) - alpha) * a;
+                            col += c * w;
+                            alpha += w;
+                            depth = select(contrib & (depth == P(kInfinity)), t, depth);
+                        }
+                        alive = alive & (alpha < term);
                     }
-                    alive = alive & (alpha < term);
                 } else if (mode == VolumeMode::MIP) {
                     maxv = select(samp, max(maxv, v), maxv);
                 } else {

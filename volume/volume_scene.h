@@ -75,6 +75,8 @@ struct VolumeScene {
     // Transfer function: entry = stored * tfMul + tfAdd.
     TFTable tf;
     float tfMul = 0, tfAdd = 0;
+    // Entries outside [tfVisibleLo, tfVisibleHi) have zero opacity (in every step table).
+    float tfVisibleLo = 0, tfVisibleHi = 0;
     float isoStored = 0;
     // Macrocells: for DVR, shaded and iso the sub-bricks (the bricks' octants, 4^3 cells:
     // finer than bricks, so fewer invisible samples are marched where a brick is only partly
@@ -160,6 +162,11 @@ struct VolumeScene {
                                      : (kSkipBit | dist[i]);
         }
         const size_t n = size_t(tf.size);
+        for (size_t e = 0; e < n; ++e)
+            if (tf.a[e] > 0.0f) {
+                if (tfVisibleHi == 0) tfVisibleLo = float(e);
+                tfVisibleHi = float(e + 1);
+            }
         rgbaSteps.resize(n * 3);
         for (int m = 0; m < 3; ++m)
             for (size_t e = 0; e < n; ++e)

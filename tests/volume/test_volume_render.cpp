@@ -162,6 +162,35 @@ TEST(VolumeDVR, SlabTransmittanceMatchesClosedForm) {
     }
 }
 
+// The march leaves out the TF fetch when no lane's entry lies in [tfVisibleLo,
+// tfVisibleHi): those must bracket exactly the entries with opacity, for a band in the
+// middle of the table, one at either end, and none at all.
+TEST(VolumeDVR, VisibleEntryRangeBracketsTheOpacity) {
+    const VolumeGrid ph = makeSheppLogan(16, Storage::U8);
+    const BrickedVolume bv = brickVolume(ph);
+    for (const char* json :
+         {R"({"colors":[[0,1,1,1],[1,1,1,1]],"opacity":[[0,0],[0.3,0],[0.31,0.2],[0.6,0.2],[0.61,0],[1,0]]})",
+          R"({"colors":[[0,1,1,1],[1,1,1,1]],"opacity":[[0,0.1],[0.5,0],[1,0]]})",
+          R"({"colors":[[0,1,1,1],[1,1,1,1]],"opacity":[[0,0],[0.5,0],[1,0.4]]})",
+          R"({"colors":[[0,1,1,1],[1,1,1,1]],"opacity":[[0,0],[1,0]]})"}) {
+        const TransferFunction tf = parseTransferFunctionJson(json, "t");
+        const VolumeScene<uint8_t> s(bv, buildTable(tf, {0.0f, 255.0f}, 0.5f), {});
+        int first = -1, last = -1;
+        for (int e = 0; e < s.tf.size; ++e)
+            if (s.tf.a[size_t(e)] > 0.0f) {
+                if (first < 0) first = e;
+                last = e;
+            }
+        if (first < 0) {
+            EXPECT_LE(s.tfVisibleHi, s.tfVisibleLo) << json;
+            continue;
+        }
+        EXPECT_EQ(s.tfVisibleLo, float(first)) << json;
+        EXPECT_EQ(s.tfVisibleHi, float(last + 1)) << json;
+        EXPECT_TRUE(first > 0 || last + 1 < s.tf.size) << json;  // each case leaves some out
+    }
+}
+
 TEST(VolumeDVR, EmptySpaceSkippingChangesNoPixel) {
     const VolumeGrid ph = makeSheppLogan(64, Storage::U16);
     const TransferFunction tf = parseTransferFunctionJson(
