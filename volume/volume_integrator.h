@@ -250,7 +250,7 @@ struct VolumeIntegrator {
                     const I info = gather(s.subInfo.data(), cid);
                     const Mask<W> skipped = info < I(0);
                     empty = alive & skipped;
-                    // The gathers read every lane: a skipped brick's lanes read pool brick 0
+                    // The gathers read every lane: a skipped sub-brick's lanes read pool brick 0
                     // (the shared zero brick), not the pool index its distance bits would give,
                     // which lies past the pool of a sparse volume.
                     start = select(skipped, I(0), (info & I(Scene::kPoolMask)) * I(Scene::template kBrickStride<L>));

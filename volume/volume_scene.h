@@ -180,6 +180,7 @@ struct VolumeScene {
 
     AABB bounds() const { return {origin + boxLo * spacing, origin + boxHi * spacing}; }
 
+   private:
     // Sub-brick i (x fastest over subs) as (brick, octant).
     std::pair<size_t, size_t> brickOctant(size_t i) const {
         const size_t sx = i % size_t(subs[0]), sy = i / size_t(subs[0]) % size_t(subs[1]),
@@ -187,8 +188,6 @@ struct VolumeScene {
         const size_t b = ((sz / 2) * size_t(cells[1]) + sy / 2) * size_t(cells[0]) + sx / 2;
         return {b, (sx & 1) + 2 * (sy & 1) + 4 * (sz & 1)};
     }
-
-   private:
     // log2 of each brick's step multiple: the largest m <= maxStepMultiple for which one
     // step of M = 2^m times the base step differs from M plain steps by at most eps =
     // adaptiveOpacity, whatever samples the brick's value range gives. With the TF's
@@ -236,7 +235,7 @@ struct VolumeScene {
         const size_t words = (size_t(n[0]) + 63) / 64, rows = size_t(n[1]) * size_t(n[2]);
         const uint64_t lastMask = n[0] % 64 == 0 ? ~uint64_t(0) : (uint64_t(1) << (n[0] % 64)) - 1;
         std::vector<int32_t> dist(size_t(n[0]) * rows, kMaxDistance);
-        std::vector<uint64_t> reached(words * rows, 0), prev;
+        std::vector<uint64_t> reached(words * rows, 0);
         size_t left = 0;
         for (size_t r = 0; r < rows; ++r)
             for (int x = 0; x < n[0]; ++x) {
@@ -248,41 +247,41 @@ struct VolumeScene {
                     ++left;
                 }
             }
-        for (int d = 1; d < kMaxDistance && left > 0; ++d) {
-            prev = reached;
-            // x: each bit ors in its two neighbours in the row
-            std::vector<uint64_t> cur(reached.size());
+        // One pass ors each row into its neighbours along y (a = 1) or z (a = 2).
+        auto orRows = [&](const std::vector<uint64_t>& src, std::vector<uint64_t>& dst, int a) {
+            const size_t step = a == 1 ? words : words * size_t(n[1]);
             for (size_t r = 0; r < rows; ++r) {
-                const uint64_t* w = prev.data() + r * words;
+                const int c = a == 1 ? int(r % size_t(n[1])) : int(r / size_t(n[1]));
+                for (size_t k = 0; k < words; ++k) {
+                    const size_t i = r * words + k;
+                    uint64_t v = src[i];
+                    if (c > 0) v |= src[i - step];
+                    if (c + 1 < n[a]) v |= src[i + step];
+                    dst[i] = v;
+                }
+            }
+        };
+        std::vector<uint64_t> alongX(reached.size()), alongY(reached.size()), next(reached.size());
+        for (int d = 1; d < kMaxDistance && left > 0; ++d) {
+            // x: each bit ors in its two neighbours in the row
+            for (size_t r = 0; r < rows; ++r) {
+                const uint64_t* w = reached.data() + r * words;
                 for (size_t k = 0; k < words; ++k) {
                     uint64_t v = w[k] | (w[k] << 1) | (w[k] >> 1);
                     if (k > 0) v |= w[k - 1] >> 63;
                     if (k + 1 < words) v |= w[k + 1] << 63;
-                    cur[r * words + k] = k + 1 == words ? v & lastMask : v;
+                    alongX[r * words + k] = k + 1 == words ? v & lastMask : v;
                 }
             }
-            // y, then z: each row ors in the rows beside it
-            for (int a = 1; a < 3; ++a) {
-                reached = cur;
-                const size_t step = a == 1 ? words : words * size_t(n[1]);
-                for (size_t r = 0; r < rows; ++r) {
-                    const int c = a == 1 ? int(r % size_t(n[1])) : int(r / size_t(n[1]));
-                    for (size_t k = 0; k < words; ++k) {
-                        const size_t i = r * words + k;
-                        uint64_t v = cur[i];
-                        if (c > 0) v |= cur[i - step];
-                        if (c + 1 < n[a]) v |= cur[i + step];
-                        reached[i] = v;
-                    }
-                }
-                if (a == 1) cur = reached;
-            }
+            orRows(alongX, alongY, 1);
+            orRows(alongY, next, 2);
             for (size_t r = 0; r < rows; ++r)
                 for (size_t k = 0; k < words; ++k)
-                    for (uint64_t fresh = reached[r * words + k] & ~prev[r * words + k]; fresh; fresh &= fresh - 1) {
+                    for (uint64_t fresh = next[r * words + k] & ~reached[r * words + k]; fresh; fresh &= fresh - 1) {
                         dist[r * size_t(n[0]) + k * 64 + size_t(__builtin_ctzll(fresh))] = d;
                         --left;
                     }
+            reached.swap(next);
         }
         return dist;
     }
