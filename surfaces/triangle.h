@@ -341,7 +341,12 @@ struct TriangleIntersector {
         const Vec3<L> a(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
         const Vec3<L> bb(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
         const Vec3<L> c(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
-        return laneTest(a, bb, c, d, float(ray.tMin), tFar, e0, e1, e2, t, [&] { return blockNormal(b); });
+        // The normal reloads the vertices (the barrier stops the compiler from keeping the
+        // first loads live across the edge test, which spills them on AVX2).
+        return laneTest(a, bb, c, d, float(ray.tMin), tFar, e0, e1, e2, t, [&] {
+            asm volatile("" ::: "memory");
+            return blockNormal(b);
+        });
     }
     // The lanes whose three edge functions agree in sign. A tolerance of 2^-16 of the
     // edge magnitudes closes vertices, where several near-zero spoke values of one fan

@@ -168,6 +168,22 @@ struct WideBVHIntersector {
         // than the binary ones they may come from, whose traversal assumes depth < 128.
         Entry stack[(K - 1) * 128 + 1];
 
+        // Leaves out of line below AVX-512: inlined, their SIMD test takes all 16 registers
+        // and the node test's ray values are spilled and reloaded at every pop, visited leaf
+        // or not; as a call they are saved only around the leaves visited.
+        static __attribute__((noinline)) bool leafOutOfLine(const WideBVHIntersector& isect, const Tree& bvh,
+                                                            int32_t first, int32_t count, const RayPacket<1>& ray,
+                                                            Hit<1>& hit) {
+            return isect.template leaf<D, AnyHit>(bvh, first, count, ray, hit);
+        }
+        static RTFACT_INLINE bool leafCall(const WideBVHIntersector& isect, const Tree& bvh, int32_t first,
+                                           int32_t count, const RayPacket<1>& ray, Hit<1>& hit) {
+            if constexpr (simd::kNativeWidth < 16)
+                return leafOutOfLine(isect, bvh, first, count, ray, hit);
+            else
+                return isect.template leaf<D, AnyHit>(bvh, first, count, ray, hit);
+        }
+
         RTFACT_INLINE void start(const Tree& bvh, const RayPacket<1>& ray, int32_t root) {
             for (int a = 0; a < 3; ++a) {
                 const float id = ray.invDir[a][0];
@@ -220,6 +236,23 @@ struct WideBVHIntersector {
                             prefetchLeaf(bvh, n.child[c]);
                         stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
                     }
+                } else if (__builtin_popcountll(bits) == 2) {
+                    // Two children (the common case): the far one is pushed, the near one
+                    // taken at once, without the sorted push and its pop.
+                    const int c0 = __builtin_ctzll(bits), c1 = __builtin_ctzll(bits & (bits - 1));
+                    Entry nearE{n.child[c0], n.count[c0], tn[c0]}, farE{n.child[c1], n.count[c1], tn[c1]};
+                    if (farE.dist <= nearE.dist) std::swap(nearE, farE);  // ties: the later slot first, as sorted
+                    if (farE.count == 0)
+                        prefetchNode(nodes + farE.child);
+                    else
+                        prefetchLeaf(bvh, farE.child);
+                    stack[sp++] = farE;
+                    if (nearE.count == 0) {
+                        node = nearE.child;
+                        prefetchNode(nodes + node);
+                        return true;
+                    }
+                    leafCall(isect, bvh, nearE.child, nearE.count, ray, hit);
                 } else {
                     const int base = sp;
                     for (; bits; bits &= bits - 1) {
@@ -244,7 +277,7 @@ struct WideBVHIntersector {
                     node = e.child;
                     return true;
                 }
-                if (isect.template leaf<D, AnyHit>(bvh, e.child, e.count, ray, hit)) return false;
+                if (leafCall(isect, bvh, e.child, e.count, ray, hit)) return false;
             }
         }
     };

@@ -53,6 +53,17 @@ struct NativeType<T, 1> {
 // Raw native chunk of W lanes of T (a plain T when W == 1).
 template <class T, int W>
 using nvec = typename NativeType<T, W>::type;
+// The same chunk at any address of a T: loads and stores of packets from arrays.
+template <class T, int W>
+struct UnalignedType {
+    typedef T type __attribute__((vector_size(sizeof(T) * W), aligned(alignof(T)), may_alias));
+};
+template <class T>
+struct UnalignedType<T, 1> {
+    using type = T;
+};
+template <class T, int W>
+using uvec = typename UnalignedType<T, W>::type;
 // Masks: AVX-512 keeps 16-lane masks in k registers (one bit per lane); other widths
 // use 0 / -1 integers per lane, also at width 1.
 #if RTFACT_NATIVE_WIDTH >= 16

@@ -44,15 +44,17 @@ struct __attribute__((may_alias)) Packet {
         p.c[0] = v;
         return p;
     }
-    // Chunk by chunk: one memcpy over the whole array becomes 16-byte moves through the
-    // stack (GCC 12), and each chunk's read then misses store forwarding.
+    // Chunk by chunk, as unaligned vector loads: one memcpy over the whole array becomes
+    // 16-byte moves through the stack (GCC 12), and a memcpy per chunk still goes through
+    // a stack slot in large functions (the AVX2 wide BVH node test: load, store, reload),
+    // each read then waiting on store forwarding.
     static RTFACT_INLINE Packet load(const T* p) {
         Packet r;
-        for (int i = 0; i < C; ++i) std::memcpy(&r.c[i], p + i * W, sizeof(Chunk));
+        for (int i = 0; i < C; ++i) r.c[i] = *reinterpret_cast<const uvec<T, W>*>(p + i * W);
         return r;
     }
     RTFACT_INLINE void store(T* p) const {
-        for (int i = 0; i < C; ++i) std::memcpy(p + i * W, &c[i], sizeof(Chunk));
+        for (int i = 0; i < C; ++i) *reinterpret_cast<uvec<T, W>*>(p + i * W) = c[i];
     }
     // Lane i = start + i * step.
     static Packet ramp(T start, T step = T(1)) {
