@@ -145,6 +145,8 @@ struct WideBVHIntersector {
     // is entered directly, more are insertion-sorted onto the stack) and a popped entry
     // is skipped once a closer hit is known. Any hit: no ordering at all, larger children
     // first (the builder's slot order). Every inner child entered or pushed is prefetched.
+    // The child visited next (the single or nearest one, any hit's first) is entered or its
+    // leaf tested at once, not pushed and popped.
     template <HitData D, bool AnyHit, class Tree>
     struct Walk {
         static constexpr int K = Tree::arity;
@@ -219,23 +221,32 @@ struct WideBVHIntersector {
                         prefetchNode(nodes + node);
                         return true;
                     }
+                    leafCall(isect, bvh, n.child[c], n.count[c], ray, hit);  // then the pops
+                    bits = 0;
                 }
             }
             if (bits) {
                 RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]),
                               "wide BVH deeper than the traversal stack");
                 if constexpr (AnyHit) {
-                    // No ordering; the last slot is pushed first, so the first (largest)
-                    // child ends on top.
-                    while (bits) {
-                        const int c = 63 - __builtin_clzll(bits);
-                        bits &= ~(uint64_t(1) << c);
+                    // No ordering: slot order. The first (largest) child is taken at once, the
+                    // others pushed last slot first, so that they pop in slot order.
+                    const int c0 = __builtin_ctzll(bits);
+                    for (uint64_t rest = bits & (bits - 1); rest;) {
+                        const int c = 63 - __builtin_clzll(rest);
+                        rest &= ~(uint64_t(1) << c);
                         if (n.count[c] == 0)
                             prefetchNode(nodes + n.child[c]);
                         else
                             prefetchLeaf(bvh, n.child[c]);
                         stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
                     }
+                    if (n.count[c0] == 0) {
+                        node = n.child[c0];
+                        prefetchNode(nodes + node);
+                        return true;
+                    }
+                    if (leafCall(isect, bvh, n.child[c0], n.count[c0], ray, hit)) return false;
                 } else if (__builtin_popcountll(bits) == 2) {
                     // Two children (the common case): the far one is pushed, the near one
                     // taken at once, without the sorted push and its pop.
