@@ -141,12 +141,12 @@ struct WideBVHIntersector {
     // One single-ray query as a resumable state: step() makes one node visit (the node
     // test, its pushes, then pops and leaves up to the next inner node), so independent
     // rays can be interleaved (traverseLanesFrom) and one ray's node load overlaps the work of
-    // the others. Closest hit: children hit are visited near to far (a single hit child
-    // is entered directly, more are insertion-sorted onto the stack) and a popped entry
-    // is skipped once a closer hit is known. Any hit: no ordering at all, larger children
-    // first (the builder's slot order). Every inner child entered or pushed is prefetched.
-    // The child visited next (the single or nearest one, any hit's first) is entered or its
-    // leaf tested at once, not pushed and popped.
+    // the others. Closest hit: children hit are visited near to far (three or more are
+    // insertion-sorted onto the stack) and a popped entry is skipped once a closer hit is
+    // known. Any hit: no ordering at all, larger children first (the builder's slot order).
+    // The child visited next (a single one, the nearer of two, any hit's first) is entered
+    // or its leaf tested at once, not pushed and popped. Every inner child entered or pushed
+    // is prefetched.
     template <HitData D, bool AnyHit, class Tree>
     struct Walk {
         static constexpr int K = Tree::arity;
@@ -180,10 +180,20 @@ struct WideBVHIntersector {
         }
         static RTFACT_INLINE bool leafCall(const WideBVHIntersector& isect, const Tree& bvh, int32_t first,
                                            int32_t count, const RayPacket<1>& ray, Hit<1>& hit) {
-            if constexpr (simd::kNativeWidth < 16)
-                return leafOutOfLine(isect, bvh, first, count, ray, hit);
+            if constexpr (simd::kNativeWidth < 16) return leafOutOfLine(isect, bvh, first, count, ray, hit);
+            return isect.template leaf<D, AnyHit>(bvh, first, count, ray, hit);
+        }
+
+        // Every inner child or leaf pushed is prefetched: its turn comes later.
+        static RTFACT_INLINE void prefetchEntry(const Tree& bvh, const Entry& e) {
+            if (e.count == 0)
+                prefetchNode(bvh.nodes.data() + e.child);
             else
-                return isect.template leaf<D, AnyHit>(bvh, first, count, ray, hit);
+                prefetchLeaf(bvh, e.child);
+        }
+        RTFACT_INLINE void push(const Tree& bvh, const Entry& e) {
+            prefetchEntry(bvh, e);
+            stack[sp++] = e;
         }
 
         RTFACT_INLINE void start(const Tree& bvh, const RayPacket<1>& ray, int32_t root) {
@@ -213,69 +223,50 @@ struct WideBVHIntersector {
                 tf = min(tf, (P::load(f + farOff[a]) - o) * i);
             }
             uint64_t bits = BitMask<K>(tn <= tf).w[0];
-            if constexpr (!AnyHit) {
-                if (bits && !(bits & (bits - 1))) {
-                    const int c = __builtin_ctzll(bits);
-                    if (!n.isLeaf(c)) {
-                        node = n.child[c];
-                        prefetchNode(nodes + node);
-                        return true;
-                    }
-                    leafCall(isect, bvh, n.child[c], n.count[c], ray, hit);  // then the pops
-                    bits = 0;
-                }
-            }
+            // The child visited next, taken at once below instead of pushed and popped.
+            Entry next{};
+            bool haveNext = false;
             if (bits) {
                 RTFACT_ASSERT(sp + K <= int(sizeof stack / sizeof stack[0]),
                               "wide BVH deeper than the traversal stack");
+                const int c0 = __builtin_ctzll(bits);
+                const uint64_t rest = bits & (bits - 1);
                 if constexpr (AnyHit) {
-                    // No ordering: slot order. The first (largest) child is taken at once, the
-                    // others pushed last slot first, so that they pop in slot order.
-                    const int c0 = __builtin_ctzll(bits);
-                    for (uint64_t rest = bits & (bits - 1); rest;) {
-                        const int c = 63 - __builtin_clzll(rest);
-                        rest &= ~(uint64_t(1) << c);
-                        if (n.count[c] == 0)
-                            prefetchNode(nodes + n.child[c]);
-                        else
-                            prefetchLeaf(bvh, n.child[c]);
-                        stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
+                    // No ordering: slot order. The first (largest) child is next, the others
+                    // are pushed last slot first, so that they pop in slot order.
+                    next = Entry{n.child[c0], n.count[c0], 0.0f};
+                    for (uint64_t r = rest; r;) {
+                        const int c = 63 - __builtin_clzll(r);
+                        r &= ~(uint64_t(1) << c);
+                        push(bvh, Entry{n.child[c], n.count[c], 0.0f});
                     }
-                    if (n.count[c0] == 0) {
-                        node = n.child[c0];
-                        prefetchNode(nodes + node);
-                        return true;
-                    }
-                    if (leafCall(isect, bvh, n.child[c0], n.count[c0], ray, hit)) return false;
-                } else if (__builtin_popcountll(bits) == 2) {
-                    // Two children (the common case): the far one is pushed, the near one
-                    // taken at once, without the sorted push and its pop.
-                    const int c0 = __builtin_ctzll(bits), c1 = __builtin_ctzll(bits & (bits - 1));
-                    Entry nearE{n.child[c0], n.count[c0], tn[c0]}, farE{n.child[c1], n.count[c1], tn[c1]};
-                    if (farE.dist <= nearE.dist) std::swap(nearE, farE);  // ties: the later slot first, as sorted
-                    if (farE.count == 0)
-                        prefetchNode(nodes + farE.child);
-                    else
-                        prefetchLeaf(bvh, farE.child);
-                    stack[sp++] = farE;
-                    if (nearE.count == 0) {
-                        node = nearE.child;
-                        prefetchNode(nodes + node);
-                        return true;
-                    }
-                    leafCall(isect, bvh, nearE.child, nearE.count, ray, hit);
+                } else if (!rest) {
+                    next = Entry{n.child[c0], n.count[c0], tn[c0]};
+                } else if (!(rest & (rest - 1))) {
+                    // Two children (the common case): the far one is pushed, the near one next.
+                    const int c1 = __builtin_ctzll(rest);
+                    Entry farE{n.child[c1], n.count[c1], tn[c1]};
+                    next = Entry{n.child[c0], n.count[c0], tn[c0]};
+                    if (farE.dist <= next.dist) std::swap(next, farE);  // ties: the later slot first, as sorted
+                    push(bvh, farE);
                 } else {
                     const int base = sp;
                     for (; bits; bits &= bits - 1) {
                         const int c = __builtin_ctzll(bits);
                         const Entry e{n.child[c], n.count[c], tn[c]};
-                        if (e.count == 0)
-                            prefetchNode(nodes + e.child);
-                        else
-                            prefetchLeaf(bvh, e.child);
+                        prefetchEntry(bvh, e);
                         pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                     }
                 }
+                haveNext = AnyHit || !(rest & (rest - 1));
+            }
+            if (haveNext) {
+                if (next.count == 0) {
+                    node = next.child;
+                    prefetchNode(nodes + node);
+                    return true;
+                }
+                if (leafCall(isect, bvh, next.child, next.count, ray, hit)) return false;
             }
             // Pop the nearest entry that can still hold a closer hit; run leaves.
             for (;;) {
