@@ -1,8 +1,10 @@
 // The triangle intersector against a double-precision reference on random rays, and on
 // rays through shared edges and vertices of a closed height field (no cracks), for
-// single rays and native packets, common and distinct origins.
+// single rays and native packets, common and distinct origins, and for the single-ray
+// test of SIMD blocks of triangles (the wide BVH's leaves).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "surfaces/triangle.h"
@@ -225,3 +227,121 @@ void checkBlocksMatchOneByOne() {
 
 TEST(Triangle, BlocksOf4MatchOneByOne) { checkBlocksMatchOneByOne<4>(); }
 TEST(Triangle, BlocksOf8MatchOneByOne) { checkBlocksMatchOneByOne<8>(); }
+
+// The single-ray block test (TriangleIntersector::intersectBlocks) against the
+// double-precision reference: one triangle per block (the padding repeats it), random
+// rays from every side, so every axis is the dominant one.
+TEST(Triangle, BlockTestAgainstReference) {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    const TriangleIntersector isect;
+    int compared = 0, hits = 0;
+    int dominant[3] = {0, 0, 0};
+    for (int iter = 0; iter < 3000; ++iter) {
+        const Triangle tri{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+        TriangleBlock<8> block;
+        const uint32_t id = 5;
+        block.fill(&id, 1, [&](uint32_t) { return tri; });
+        const Vec3f o{3.0f * u(rng), 3.0f * u(rng), 3.0f * u(rng)};
+        const Vec3f target = (tri.v0 + tri.v1 + tri.v2) * (1.0f / 3.0f) + Vec3f(u(rng), u(rng), u(rng)) * 0.5f;
+        const Vec3f d = normalize(target - o);
+        RayPacket<1> ray;
+        ray.setLane(0, o, d);
+        ray.finalize();
+        const Vec3f ad(std::fabs(d.x), std::fabs(d.y), std::fabs(d.z));
+        ++dominant[ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2)];
+        TriangleIntersector::Hit<1> hit;
+        hit.t = ray.tMax;
+        hit.id = -1;
+        hit.u = hit.v = 0.0f;
+        isect.intersectBlocks<HitData::Shading>(&block, 1, ray, hit);
+        TriangleIntersector::Hit<1> any;
+        any.t = ray.tMax;
+        any.id = -1;
+        const bool occ = isect.occludedBlocks(&block, 1, ray, any);
+        const RefHit r = reference(tri, o, d);
+        if (std::fabs(r.edge) < 1e-4) continue;  // too close to an edge to call
+        ++compared;
+        ASSERT_EQ(r.hit, int32_t(hit.id) == 5) << "iter " << iter;
+        ASSERT_EQ(r.hit, occ) << "iter " << iter;
+        if (!r.hit) continue;
+        ++hits;
+        EXPECT_NEAR(float(hit.t), r.t, 1e-4 * std::max(1.0, r.t));
+        EXPECT_NEAR(float(any.t), r.t, 1e-4 * std::max(1.0, r.t));
+        EXPECT_NEAR(float(hit.u), r.u, 1e-3);
+        EXPECT_NEAR(float(hit.v), r.v, 1e-3);
+    }
+    EXPECT_GT(compared, 2500);
+    EXPECT_GT(hits, 600);
+    for (int a = 0; a < 3; ++a) EXPECT_GT(dominant[a], 500) << "axis " << a;
+}
+
+// Rays through shared edges and vertices of the closed height field, against its
+// triangles packed into SIMD blocks (neighbours in different blocks, paired and single
+// tests mixed): the single-ray block test must have no cracks either, whichever axis
+// dominates the ray.
+template <int L>
+void checkBlockEdges() {
+    const Mesh m = test::heightField(8, 3);
+    std::vector<Triangle> tris;
+    for (size_t t = 0; t < m.triangles(); ++t)
+        tris.push_back(
+            {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]});
+    std::mt19937 rng(31 + L);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    // Blocks of a shuffled order, the last one partly filled.
+    std::vector<uint32_t> order(tris.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
+    std::shuffle(order.begin(), order.end(), rng);
+    std::vector<TriangleBlock<L>> blocks;
+    for (size_t i = 0; i < order.size(); i += L) {
+        blocks.emplace_back();
+        blocks.back().fill(order.data() + i, int(std::min(order.size() - i, size_t(L))),
+                           [&](uint32_t k) { return tris[k]; });
+    }
+    std::vector<Vec3f> targets;
+    for (size_t t = 0; t < m.triangles(); ++t)
+        for (int e = 0; e < 3; ++e) {
+            const Vec3f a = m.positions[m.indices[3 * t + e]], b = m.positions[m.indices[3 * t + (e + 1) % 3]];
+            for (float s : {0.0f, 0.25f, 0.5f, 0.7f, 1.0f / 3.0f}) {
+                const Vec3f p = a + (b - a) * s;
+                if (std::fabs(p.x) < 0.99f && std::fabs(p.z) < 0.99f) targets.push_back(p);
+            }
+        }
+    const TriangleIntersector isect;
+    size_t misses = 0, anyMisses = 0, rays = 0;
+    for (int pass = 0; pass < 4; ++pass)
+        for (const Vec3f& p : targets) {
+            // Origins all around (inside the closed surface too): the surface point at
+            // t = 1 is reached whatever lies in front of it.
+            const Vec3f o = pass == 0 ? Vec3f{0.5f * u(rng), 3.0f, 0.5f * u(rng)}
+                                      : Vec3f{3.0f * u(rng), 3.0f * u(rng), 3.0f * u(rng)};
+            RayPacket<1> r;
+            r.setLane(0, o, p - o);  // unnormalised: the edge point is at t = 1
+            r.finalize();
+            ++rays;
+            TriangleIntersector::Hit<1> hit;
+            hit.t = r.tMax;
+            hit.id = -1;
+            hit.u = hit.v = 0.0f;
+            // all blocks in one call (paired where the ISA allows), or one at a time
+            const int n = int(blocks.size());
+            if (pass % 2 == 0)
+                isect.intersectBlocks<HitData::Shading>(blocks.data(), n, r, hit);
+            else
+                for (int b = 0; b < n; ++b) isect.intersectBlocks<HitData::Shading>(blocks.data() + b, 1, r, hit);
+            if (int32_t(hit.id) < 0)
+                ++misses;
+            else
+                EXPECT_LE(float(hit.t), 1.0f + 1e-4f) << "target " << p.x << "," << p.y << "," << p.z;
+            TriangleIntersector::Hit<1> any;
+            any.t = 1.0f + 1e-3f;
+            any.id = -1;
+            anyMisses += !isect.occludedBlocks(blocks.data(), n, r, any);
+        }
+    EXPECT_EQ(misses, 0u) << "rays through shared edges/vertices slipped through (cracks) out of " << rays;
+    EXPECT_EQ(anyMisses, 0u) << "any-hit rays through shared edges/vertices slipped through out of " << rays;
+}
+
+TEST(Triangle, SharedEdgesNoCracksBlocksOf4) { checkBlockEdges<4>(); }
+TEST(Triangle, SharedEdgesNoCracksBlocksOf8) { checkBlockEdges<8>(); }
