@@ -91,25 +91,36 @@ void checkRandom(bool commonOrigin) {
 
 // Rays through points on shared edges (and exactly through vertices) of a closed height
 // field: at least one triangle must report the hit, at the right distance.
-template <int N>
-void checkEdges(bool commonOrigin) {
-    const Mesh m = test::heightField(8, 3);
+// The closed height field's triangles and points on their shared edges and vertices.
+struct EdgeTargets {
     std::vector<Triangle> tris;
-    for (size_t t = 0; t < m.triangles(); ++t)
-        tris.push_back(
-            {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]});
-    std::mt19937 rng(11 + N);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     std::vector<Vec3f> targets;
+};
+EdgeTargets heightFieldEdges() {
+    const Mesh m = test::heightField(8, 3);
+    EdgeTargets h;
+    for (size_t t = 0; t < m.triangles(); ++t)
+        h.tris.push_back(
+            {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]});
     for (size_t t = 0; t < m.triangles(); ++t)
         for (int e = 0; e < 3; ++e) {
             const Vec3f a = m.positions[m.indices[3 * t + e]], b = m.positions[m.indices[3 * t + (e + 1) % 3]];
             for (float s : {0.0f, 0.25f, 0.5f, 0.7f, 1.0f / 3.0f}) {
                 // Only interior edges and vertices are shared by two triangles.
                 const Vec3f p = a + (b - a) * s;
-                if (std::fabs(p.x) < 0.99f && std::fabs(p.z) < 0.99f) targets.push_back(p);
+                if (std::fabs(p.x) < 0.99f && std::fabs(p.z) < 0.99f) h.targets.push_back(p);
             }
         }
+    return h;
+}
+
+template <int N>
+void checkEdges(bool commonOrigin) {
+    const EdgeTargets h = heightFieldEdges();
+    const std::vector<Triangle>& tris = h.tris;
+    const std::vector<Vec3f>& targets = h.targets;
+    std::mt19937 rng(11 + N);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     const TriangleIntersector isect;
     size_t misses = 0, rays = 0;
     for (size_t base = 0; base < targets.size(); base += N) {
@@ -282,11 +293,9 @@ TEST(Triangle, BlockTestAgainstReference) {
 // dominates the ray.
 template <int L>
 void checkBlockEdges() {
-    const Mesh m = test::heightField(8, 3);
-    std::vector<Triangle> tris;
-    for (size_t t = 0; t < m.triangles(); ++t)
-        tris.push_back(
-            {m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]});
+    const EdgeTargets h = heightFieldEdges();
+    const std::vector<Triangle>& tris = h.tris;
+    const std::vector<Vec3f>& targets = h.targets;
     std::mt19937 rng(31 + L);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     // Blocks of a shuffled order, the last one partly filled.
@@ -299,15 +308,6 @@ void checkBlockEdges() {
         blocks.back().fill(order.data() + i, int(std::min(order.size() - i, size_t(L))),
                            [&](uint32_t k) { return tris[k]; });
     }
-    std::vector<Vec3f> targets;
-    for (size_t t = 0; t < m.triangles(); ++t)
-        for (int e = 0; e < 3; ++e) {
-            const Vec3f a = m.positions[m.indices[3 * t + e]], b = m.positions[m.indices[3 * t + (e + 1) % 3]];
-            for (float s : {0.0f, 0.25f, 0.5f, 0.7f, 1.0f / 3.0f}) {
-                const Vec3f p = a + (b - a) * s;
-                if (std::fabs(p.x) < 0.99f && std::fabs(p.z) < 0.99f) targets.push_back(p);
-            }
-        }
     const TriangleIntersector isect;
     size_t misses = 0, anyMisses = 0, rays = 0;
     for (int pass = 0; pass < 4; ++pass)
