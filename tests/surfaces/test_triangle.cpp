@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 
 #include "surfaces/triangle.h"
@@ -89,8 +90,6 @@ void checkRandom(bool commonOrigin) {
     EXPECT_GT(hits, 50 * N);
 }
 
-// Rays through points on shared edges (and exactly through vertices) of a closed height
-// field: at least one triangle must report the hit, at the right distance.
 // The closed height field's triangles and points on their shared edges and vertices.
 struct EdgeTargets {
     std::vector<Triangle> tris;
@@ -114,6 +113,8 @@ EdgeTargets heightFieldEdges() {
     return h;
 }
 
+// Rays through points on shared edges (and exactly through vertices) of a closed height
+// field: at least one triangle must report the hit, at the right distance.
 template <int N>
 void checkEdges(bool commonOrigin) {
     const EdgeTargets h = heightFieldEdges();
@@ -300,7 +301,7 @@ void checkBlockEdges() {
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     // Blocks of a shuffled order, the last one partly filled.
     std::vector<uint32_t> order(tris.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
+    std::iota(order.begin(), order.end(), 0u);
     std::shuffle(order.begin(), order.end(), rng);
     std::vector<TriangleBlock<L>> blocks;
     for (size_t i = 0; i < order.size(); i += L) {
