@@ -221,7 +221,43 @@ struct VolumeIntegrator {
         auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) {
             return -floor(-((tx - tNear) * invDt - P(0.5f)));
         };
+        // Volumes in the plain row layout (the y-pair copy is made only for cache-sized ones)
+        // wait on memory each time a ray enters a brick: two lanes of the group (its first
+        // and last alive ones: opposite corners of its footprint) prefetch the brick one
+        // brick edge ahead along their ray and its sub-brick entries, once per brick (the
+        // last two bricks prefetched are remembered: the two lanes mostly share one).
+        int32_t recent[2] = {-1, -1};
+        const float aheadT = float(Scene::kCells) * s.dt / s.settings.stepVoxels;
+        auto prefetchAhead = [&](int i) __attribute__((always_inline)) {
+            const float ta = t[i] + aheadT;
+            int32_t b[3];
+            for (int a = 0; a < 3; ++a) {
+                const float x = oi[a][i] + di[a][i] * ta;
+                b[a] = int32_t(x > 0.0f ? std::min(x, s.clampHi[a]) : 0.0f) >> 3;  // NaN: 0
+            }
+            const int32_t id = b[0] + b[1] * s.nbx + b[2] * s.nbxy;
+            if (id == recent[0] || id == recent[1]) return;
+            recent[1] = recent[0];
+            recent[0] = id;
+            // its eight sub-brick entries: two per line along x
+            const int32_t sx = s.subs[0], sxy = s.subs[0] * s.subs[1];
+            const int32_t* si = s.subInfo.data() + 2 * (b[0] + b[1] * sx + b[2] * sxy);
+            __builtin_prefetch(si);
+            __builtin_prefetch(si + sx);
+            __builtin_prefetch(si + sxy);
+            __builtin_prefetch(si + sx + sxy);
+            const char* q = reinterpret_cast<const char*>(s.voxels + s.brickStart[id]);
+            const char* end = q + sizeof(typename Scene::Voxel) * size_t(Scene::kBrick);
+            for (q = reinterpret_cast<const char*>(uintptr_t(q) & ~uintptr_t(63)); q < end; q += 64)
+                __builtin_prefetch(q);
+        };
         while (any(alive)) {
+            if constexpr (L == VoxelLayout::Rows) {
+                static_assert(W <= 64);
+                const uint64_t lanes = BitMask<W>(alive).w[0];
+                prefetchAhead(__builtin_ctzll(lanes));
+                prefetchAhead(63 - __builtin_clzll(lanes));
+            }
             const Vec3<W> p = clampToGrid<W>(s, oi + di * t);
             // the sample's cell, its brick and sub-brick (p >= 0: floor(p / 8) = floor(p) / 8;
             // p < dims - 1 keeps them inside their grids)
