@@ -221,11 +221,12 @@ struct VolumeIntegrator {
         auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) {
             return -floor(-((tx - tNear) * invDt - P(0.5f)));
         };
-        // Volumes in the plain row layout (the y-pair copy is made only for cache-sized ones)
-        // wait on memory each time a ray enters a brick: two lanes of the group (its first
-        // and last alive ones: opposite corners of its footprint) prefetch the brick one
-        // brick edge ahead along their ray and its sub-brick entries, once per brick (the
-        // last two bricks prefetched are remembered: the two lanes mostly share one).
+        // Volumes larger than the caches (VolumeScene::prefetchBricks; the y-pair copy is made
+        // only for cache-sized ones) wait on memory each time a ray enters a brick: two lanes
+        // of the group (its first and last alive ones: opposite corners of its footprint)
+        // prefetch the brick one brick edge ahead along their ray and its sub-brick entries,
+        // once per brick (the last two bricks prefetched are remembered: the two lanes mostly
+        // share one). In cache the prefetches cost more than they save.
         int32_t recent[2] = {-1, -1};
         const float aheadT = float(Scene::kCells) * s.dt / s.settings.stepVoxels;
         auto prefetchAhead = [&](int i) __attribute__((always_inline)) {
@@ -251,8 +252,10 @@ struct VolumeIntegrator {
             for (q = reinterpret_cast<const char*>(uintptr_t(q) & ~uintptr_t(63)); q < end; q += 64)
                 __builtin_prefetch(q);
         };
+        uint32_t iteration = 0;
         while (any(alive)) {
-            if constexpr (L == VoxelLayout::Rows) {
+            // every fourth step: the brick ahead is at least kCells / stepVoxels steps away
+            if (L == VoxelLayout::Rows && s.prefetchBricks && (iteration++ & 3) == 0) {
                 static_assert(W <= 64);
                 const uint64_t lanes = BitMask<W>(alive).w[0];
                 prefetchAhead(__builtin_ctzll(lanes));

@@ -97,6 +97,10 @@ struct VolumeScene {
     // one 64-bit gather fetches an entry.
     std::vector<uint64_t> rgbaSteps;
     std::vector<float> cellMax;
+    // The march prefetches the bricks ahead of its rays (row layout): volumes whose pool
+    // is larger than the last-level caches, where it waits on memory at every new brick.
+    static constexpr size_t kPrefetchPoolBytes = size_t(64) << 20;
+    bool prefetchBricks = false;
 
     VolumeScene(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& s) : settings(s), tf(table) {
         for (int a = 0; a < 3; ++a) {
@@ -106,6 +110,7 @@ struct VolumeScene {
             subs[a] = 2 * v.nb[a];
         }
         voxels = v.data<T>();
+        prefetchBricks = v.pool.size() > kPrefetchPoolBytes;
         brickStart = v.brickStart.data();
         if (sizeof(T) < 4 && !v.pairs.empty()) {
             pairVoxels = reinterpret_cast<const T*>(v.pairs.data());
