@@ -73,6 +73,12 @@ struct LoDWideIntersector {
         __builtin_prefetch(bvh.childReps[size_t(n)].radius);
     }
 
+    // A leaf's first block of discs (its turn comes later: pushed entries are fetched early).
+    static RTFACT_INLINE void prefetchLeaf(const LoDWideBVH& bvh, int32_t first) {
+        const char* p = reinterpret_cast<const char*>(bvh.blocks.data() + first);
+        for (size_t o = 0; o < sizeof(bvh.blocks[0]); o += 64) __builtin_prefetch(p + o);
+    }
+
     // The ray against the representatives of the children in `cut`; returns true when an
     // any-hit query is done.
     template <bool AnyHit>
@@ -173,7 +179,10 @@ struct LoDWideIntersector {
                     while (bits) {
                         const int c = 63 - __builtin_clzll(bits);
                         bits &= ~(uint64_t(1) << c);
-                        if (n.count[c] == 0) prefetchNode(bvh, n.child[c]);
+                        if (n.count[c] == 0)
+                            prefetchNode(bvh, n.child[c]);
+                        else
+                            prefetchLeaf(bvh, n.child[c]);
                         stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
                     }
                 } else {
@@ -181,7 +190,10 @@ struct LoDWideIntersector {
                     for (; bits; bits &= bits - 1) {
                         const int c = __builtin_ctzll(bits);
                         const Entry e{n.child[c], n.count[c], tn[c]};
-                        if (e.count == 0) prefetchNode(bvh, e.child);
+                        if (e.count == 0)
+                            prefetchNode(bvh, e.child);
+                        else
+                            prefetchLeaf(bvh, e.child);
                         pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                     }
                 }
@@ -343,7 +355,10 @@ struct LoDWideIntersector {
                     }
                 }
                 Entry e{n.child[c], n.count[c], 0.0f, m, node, c};
-                if (e.count == 0) prefetchNode(bvh, e.child);
+                if (e.count == 0)
+                    prefetchNode(bvh, e.child);
+                else
+                    prefetchLeaf(bvh, e.child);
                 if constexpr (AnyHit) {
                     stack[sp++] = e;
                 } else {
