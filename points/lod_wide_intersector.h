@@ -230,10 +230,17 @@ struct LoDWideIntersector {
 
     template <bool CommonOrigin, HitData D, bool AnyHit, int N>
     void traceChunks(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit) const {
+        constexpr int W = Packet<N>::W;
         const BitMask<N> bits(hit.t > Packet<N>(-kInfinity));
         for (int k = 0; k < Packet<N>::C; ++k)
-            if (const uint32_t lanes = bits.chunkBits(k))
+            if (const uint32_t lanes = bits.chunkBits(k)) {
                 traverseChunk<CommonOrigin, D, AnyHit>(bvh, rays, hit, k, lanes);
+                // The shading reads each hit disc next (a cache miss per pixel on large
+                // clouds): start those loads while the other chunks trace.
+                if constexpr (!AnyHit)
+                    for (int i = k * W; i < (k + 1) * W; ++i)
+                        if (const int32_t id = hit.id[i]; id >= 0) __builtin_prefetch(&bvh.elems[size_t(id)]);
+            }
     }
 
     // Packet lane i as a single ray from inner node `start`; the result goes back into hit.
