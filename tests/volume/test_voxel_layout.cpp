@@ -137,3 +137,38 @@ TEST(VoxelLayout, ImagesEqualWithoutPairs) {
         EXPECT_GT(sum, 0.0f) << int(m);  // something was drawn
     }
 }
+
+// The march prefetches bricks ahead of its rays on volumes beyond the caches
+// (VolumeScene::prefetchBricks, row layout): forced on for a small volume, it changes no
+// pixel, from outside the box and from inside it (the brick ahead clamped to the grid).
+TEST(VoxelLayout, BrickPrefetchChangesNoPixel) {
+    BrickedVolume bv = brickVolume(makeSheppLogan(45, Storage::U16));
+    bv.pairs.clear();  // the row layout, the one that prefetches
+    const TransferFunction tf = transferFunctionPreset("ct-bone");
+    const auto [lo, hi] = bv.valueRange();
+    VolumeRenderSettings rs;
+    const TFTable table = buildTable(tf, {lo, hi}, rs.stepVoxels);
+    VolumeScene<uint16_t> scene(bv, table, rs);
+    EXPECT_FALSE(scene.prefetchBricks) << "a 45^3 volume fits the caches";
+    const AABB box = scene.bounds();
+    const CameraFrame views[2] = {fitCamera(box, 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}),
+                                  {box.center(), box.center() + Vec3f(0.7f, 0.2f, -0.4f), {0, 0, 1}, 100.0f}};
+    for (const CameraFrame& view : views) {
+        const PinholeCamera cam(view, 48, 48);
+        std::vector<float> img[2];
+        for (int on = 0; on < 2; ++on) {
+            scene.prefetchBricks = on == 1;
+            RGBAFramebuffer fb(48, 48);
+            RenderOptions ro;
+            ro.progress = false;
+            renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+            img[on] = fb.resolved(1);
+        }
+        float sum = 0;
+        for (size_t i = 0; i < img[0].size(); ++i) {
+            ASSERT_EQ(img[0][i], img[1][i]) << "pixel value " << i;
+            sum += img[0][i];
+        }
+        EXPECT_GT(sum, 0.0f);  // something was drawn
+    }
+}
