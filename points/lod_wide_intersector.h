@@ -17,6 +17,7 @@
 #include "core/concepts/camera.h"
 #include "core/concepts/intersector.h"
 #include "core/util/assert.h"
+#include "core/util/prefetch.h"
 #include "points/lod_wide_bvh.h"
 #include "points/ray_disc_plane.h"
 
@@ -73,10 +74,12 @@ struct LoDWideIntersector {
         __builtin_prefetch(bvh.childReps[size_t(n)].radius);
     }
 
-    // A leaf's first block of discs (its turn comes later: pushed entries are fetched early).
-    static RTFACT_INLINE void prefetchLeaf(const LoDWideBVH& bvh, int32_t first) {
-        const char* p = reinterpret_cast<const char*>(bvh.blocks.data() + first);
-        for (size_t o = 0; o < sizeof(bvh.blocks[0]); o += 64) __builtin_prefetch(p + o);
+    // A pushed entry's inner node, or its leaf's first block of discs: its turn comes later.
+    static RTFACT_INLINE void prefetchEntry(const LoDWideBVH& bvh, int32_t child, int32_t count) {
+        if (count == 0)
+            prefetchNode(bvh, child);
+        else
+            prefetchBytes(bvh.blocks.data() + child, sizeof(bvh.blocks[0]));
     }
 
     // The ray against the representatives of the children in `cut`; returns true when an
@@ -179,10 +182,7 @@ struct LoDWideIntersector {
                     while (bits) {
                         const int c = 63 - __builtin_clzll(bits);
                         bits &= ~(uint64_t(1) << c);
-                        if (n.count[c] == 0)
-                            prefetchNode(bvh, n.child[c]);
-                        else
-                            prefetchLeaf(bvh, n.child[c]);
+                        prefetchEntry(bvh, n.child[c], n.count[c]);
                         stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
                     }
                 } else {
@@ -190,10 +190,7 @@ struct LoDWideIntersector {
                     for (; bits; bits &= bits - 1) {
                         const int c = __builtin_ctzll(bits);
                         const Entry e{n.child[c], n.count[c], tn[c]};
-                        if (e.count == 0)
-                            prefetchNode(bvh, e.child);
-                        else
-                            prefetchLeaf(bvh, e.child);
+                        prefetchEntry(bvh, e.child, e.count);
                         pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                     }
                 }
@@ -362,10 +359,7 @@ struct LoDWideIntersector {
                     }
                 }
                 Entry e{n.child[c], n.count[c], 0.0f, m, node, c};
-                if (e.count == 0)
-                    prefetchNode(bvh, e.child);
-                else
-                    prefetchLeaf(bvh, e.child);
+                prefetchEntry(bvh, e.child, e.count);
                 if constexpr (AnyHit) {
                     stack[sp++] = e;
                 } else {

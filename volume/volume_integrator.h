@@ -7,6 +7,7 @@
 #pragma once
 #include "core/concepts/integrator.h"
 #include "core/render/render_counters.h"
+#include "core/util/prefetch.h"
 #include "volume/volume_scene.h"
 #include "volume/voxel_gather.h"
 
@@ -247,10 +248,7 @@ struct VolumeIntegrator {
             __builtin_prefetch(si + sx);
             __builtin_prefetch(si + sxy);
             __builtin_prefetch(si + sx + sxy);
-            const char* q = reinterpret_cast<const char*>(s.voxels + s.brickStart[id]);
-            const char* end = q + sizeof(typename Scene::Voxel) * size_t(Scene::kBrick);
-            for (q = reinterpret_cast<const char*>(uintptr_t(q) & ~uintptr_t(63)); q < end; q += 64)
-                __builtin_prefetch(q);
+            prefetchBytes(s.voxels + s.brickStart[id], sizeof(typename Scene::Voxel) * size_t(Scene::kBrick));
         };
         uint32_t iteration = 0;
         while (any(alive)) {

@@ -87,6 +87,16 @@ void checkLayouts(Storage st, float maxValue) {
     }
 }
 
+// One pixel-centre pass of a w x h view, resolved.
+template <class Scene>
+std::vector<float> renderView(const Scene& scene, const PinholeCamera& cam, int w, int h) {
+    RGBAFramebuffer fb(w, h);
+    RenderOptions ro;
+    ro.progress = false;
+    renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+    return fb.resolved(1);
+}
+
 std::vector<float> renderDvr(const BrickedVolume& bv, VolumeMode mode) {
     const TransferFunction tf = transferFunctionPreset("ct-bone");
     const auto [lo, hi] = bv.valueRange();
@@ -97,11 +107,7 @@ std::vector<float> renderDvr(const BrickedVolume& bv, VolumeMode mode) {
     std::vector<float> out;
     withVolumeScene(bv, table, rs, [&](const auto& scene) {
         const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}), 64, 64);
-        RGBAFramebuffer fb(64, 64);
-        RenderOptions ro;
-        ro.progress = false;
-        renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
-        out = fb.resolved(1);
+        out = renderView(scene, cam, 64, 64);
     });
     return out;
 }
@@ -158,11 +164,7 @@ TEST(VoxelLayout, BrickPrefetchChangesNoPixel) {
         std::vector<float> img[2];
         for (int on = 0; on < 2; ++on) {
             scene.prefetchBricks = on == 1;
-            RGBAFramebuffer fb(48, 48);
-            RenderOptions ro;
-            ro.progress = false;
-            renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
-            img[on] = fb.resolved(1);
+            img[on] = renderView(scene, cam, 48, 48);
         }
         float sum = 0;
         for (size_t i = 0; i < img[0].size(); ++i) {
