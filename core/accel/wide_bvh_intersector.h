@@ -16,6 +16,7 @@
 #include "core/concepts/intersector_hooks.h"
 #include "core/geometry/sphere.h"
 #include "core/util/assert.h"
+#include "core/util/prefetch.h"
 
 namespace rtfact {
 
@@ -132,10 +133,9 @@ struct WideBVHIntersector {
     // the stack lets the load start before the leaf's turn).
     template <class Tree>
     static RTFACT_INLINE void prefetchLeaf(const Tree& bvh, int32_t first) {
-        if constexpr (requires { bvh.blocks; }) {
-            const char* p = reinterpret_cast<const char*>(bvh.blocks.data() + first);
-            for (size_t o = 0; o < sizeof(typename Tree::BlockType); o += 64) __builtin_prefetch(p + o);
-        }
+        // Every line the block touches: a block need not start on a line.
+        if constexpr (requires { bvh.blocks; })
+            prefetchBytes(bvh.blocks.data() + first, sizeof(typename Tree::BlockType));
     }
 
     // One single-ray query as a resumable state: step() makes one node visit (the node
