@@ -296,12 +296,16 @@ struct VolumeIntegrator {
                         I l = shiftRight<W>(info, 28) & I(3);
                         if (any(l > I(0))) {
                             // A long step stands for samples kf .. kf + m - 1, which must all
-                            // lie in this brick and before tFar: near either it shortens to the
+                            // lie in this brick (this sub-brick where the multiple is the
+                            // sub-brick's own) and before tFar: near either it shortens to the
                             // samples left (a power of two), so it never carries the brick's
                             // opacity into the next one or past the box (a data-parallel rank's
                             // neighbour has those samples), and homogeneous bricks stay exact.
                             // (samples kf + 1, kf + 3 lie dt, 3 dt past t)
-                            const P room = min(cubeExit(c, I(1), invBrick), tFar) - t;
+                            const Mask<W> subScope = (info & I(Scene::kSubScopeBit)) != I(0);
+                            P exitT = cubeExit(c, I(1), invBrick);
+                            if (any(subScope)) exitT = select(subScope, cubeExit(sc, I(1), invSub), exitT);
+                            const P room = min(exitT, tFar) - t;
                             l = select(room > dt3, l, select(room > dt, min(l, I(1)), I(0)));
                         }
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));

@@ -88,10 +88,11 @@ struct VolumeScene {
     // Per sub-brick, one load for the march. Skipped (sign bit set): the low bits hold the
     // Chebyshev distance in sub-bricks to the nearest one that is not skipped (>= 1), so a
     // ray jumps the whole empty cube around it. Otherwise: its brick's pool brick (start /
-    // kBrick) in bits 0-27, log2 of the step multiple in bits 28-29 (the brick's; 0 where the
-    // TF hides the sub-brick, so that a march without skipping reaches the same samples).
+    // kBrick) in bits 0-27, log2 of the step multiple in bits 28-29 and, in bit 30, whether
+    // that multiple is the sub-brick's own rather than its brick's (stepBits).
     std::vector<int32_t> subInfo;
     static constexpr int32_t kSkipBit = int32_t(0x80000000u), kPoolMask = (1 << 28) - 1, kMaxDistance = 16;
+    static constexpr int32_t kSubScopeBit = 1 << 30;
     // Transfer-function tables for 1, 2 and 4 steps (tf.size entries each): r, g, b and
     // the opacity 1 - (1 - a)^m of table m as four halves per entry (half_float.h), so that
     // one 64-bit gather fetches an entry.
@@ -158,13 +159,12 @@ struct VolumeScene {
             subFlags[i] = (on || !s.skipping) ? 1 : 0;
         }
         subInfo.resize(ns);
-        const std::vector<int32_t> multiple = stepMultiples(v);
+        const std::vector<int32_t> steps = stepBits(v, visible);
         const std::vector<int32_t> dist = emptyDistance();
         for (size_t i = 0; i < ns; ++i) {
             const size_t b = brickOctant(i).first;
             if (v.brickStart[b] / kBrick > kPoolMask) throw Error("", "volume too large for the brick table");
-            subInfo[i] = subFlags[i] ? (v.brickStart[b] / kBrick) | ((visible[i] ? multiple[b] : 0) << 28)
-                                     : (kSkipBit | dist[i]);
+            subInfo[i] = subFlags[i] ? (v.brickStart[b] / kBrick) | steps[i] : (kSkipBit | dist[i]);
         }
         const size_t n = size_t(tf.size);
         for (size_t e = 0; e < n; ++e)
@@ -193,41 +193,54 @@ struct VolumeScene {
         const size_t b = ((sz / 2) * size_t(cells[1]) + sy / 2) * size_t(cells[0]) + sx / 2;
         return {b, (sx & 1) + 2 * (sy & 1) + 4 * (sz & 1)};
     }
-    // log2 of each brick's step multiple: the largest m <= maxStepMultiple for which one
-    // step of M = 2^m times the base step differs from M plain steps by at most eps =
-    // adaptiveOpacity, whatever samples the brick's value range gives. With the TF's
-    // opacities amin..amax over that range, M plain steps reach an opacity between
-    // 1 - (1 - amin)^M and 1 - (1 - amax)^M, as does the one long step, so the opacity
-    // error is at most their difference; the colour error is at most the colour range
-    // times the opacity 1 - (1 - amax)^M. Faint bricks (the earlier rule: every entry's
-    // M-step opacity <= eps) pass both, and so do homogeneous ones at any opacity, where
-    // the long step is exact. Bricks the TF leaves invisible keep m = 0, so that a march
-    // without skipping reaches the same sample positions as one that skips them.
-    std::vector<int32_t> stepMultiples(const BrickedVolume& v) const {
-        std::vector<int32_t> out(v.brickCount(), 0);
+    // Per sub-brick, the step bits of subInfo: log2 of the step multiple of its brick or,
+    // where the brick's value range allows none, of the sub-brick alone (with kSubScopeBit:
+    // long steps then end at the sub-brick's exit). 0 where the TF hides the sub-brick, so
+    // that a march without skipping reaches the same sample positions as one that skips.
+    std::vector<int32_t> stepBits(const BrickedVolume& v, const std::vector<uint8_t>& visible) const {
+        const size_t ns = visible.size();
+        std::vector<int32_t> out(ns, 0);
         const bool dvr = settings.mode == VolumeMode::DVR || settings.mode == VolumeMode::Shaded;
         if (!dvr || settings.maxStepMultiple < 2) return out;
         const TFRangeExtrema extrema(tf);
-        const float eps = settings.adaptiveOpacity;
-        for (size_t i = 0; i < out.size(); ++i) {
-            const float lo = v.cellLo[i] * v.scale + v.offset, hi = v.cellHi[i] * v.scale + v.offset;
-            if (!tf.visible(std::min(lo, hi), std::max(lo, hi))) continue;
-            int i0 = tf.index(lo), i1 = tf.index(hi);
-            if (i0 > i1) std::swap(i0, i1);
-            const TFRangeExtrema::Extrema e = extrema.range(i0, i1);
-            const float amin = std::min(e.lo[3], 1.0f), amax = std::min(e.hi[3], 1.0f);
-            const float dc = std::max({e.hi[0] - e.lo[0], e.hi[1] - e.lo[1], e.hi[2] - e.lo[2]});
-            for (int m = 2; m >= 1; --m) {
-                const float M = float(1 << m);
-                if ((1 << m) > settings.maxStepMultiple) continue;
-                const float tmin = std::pow(1.0f - amin, M), tmax = std::pow(1.0f - amax, M);
-                if (tmin - tmax <= eps && dc * (1.0f - tmax) <= eps) {
-                    out[i] = m;
-                    break;
-                }
+        std::vector<int8_t> brickM(v.brickCount(), -1);  // -1: not computed yet
+        auto stored = [&](float x) { return x * v.scale + v.offset; };
+        for (size_t i = 0; i < ns; ++i) {
+            if (!visible[i]) continue;
+            const auto [b, o] = brickOctant(i);
+            if (brickM[b] < 0) brickM[b] = int8_t(stepMultiple(extrema, stored(v.cellLo[b]), stored(v.cellHi[b])));
+            if (brickM[b] > 0) {
+                out[i] = int32_t(brickM[b]) << 28;
+            } else if (const int m = stepMultiple(extrema, stored(v.subLo[b * 8 + o]), stored(v.subHi[b * 8 + o]))) {
+                out[i] = (m << 28) | kSubScopeBit;
             }
         }
         return out;
+    }
+    // log2 of the step multiple for values in [lo, hi]: the largest m <= maxStepMultiple
+    // for which one step of M = 2^m times the base step differs from M plain steps by at
+    // most eps = adaptiveOpacity, whatever samples the range gives. With the TF's
+    // opacities amin..amax over that range, M plain steps reach an opacity between
+    // 1 - (1 - amin)^M and 1 - (1 - amax)^M, as does the one long step, so the opacity
+    // error is at most their difference; the colour error is at most the colour range
+    // times the opacity 1 - (1 - amax)^M. Faint ranges (the earlier rule: every entry's
+    // M-step opacity <= eps) pass both, and so do homogeneous ones at any opacity, where
+    // the long step is exact. Ranges the TF leaves invisible keep m = 0.
+    int stepMultiple(const TFRangeExtrema& extrema, float lo, float hi) const {
+        if (!tf.visible(std::min(lo, hi), std::max(lo, hi))) return 0;
+        int i0 = tf.index(lo), i1 = tf.index(hi);
+        if (i0 > i1) std::swap(i0, i1);
+        const TFRangeExtrema::Extrema e = extrema.range(i0, i1);
+        const float amin = std::min(e.lo[3], 1.0f), amax = std::min(e.hi[3], 1.0f);
+        const float dc = std::max({e.hi[0] - e.lo[0], e.hi[1] - e.lo[1], e.hi[2] - e.lo[2]});
+        const float eps = settings.adaptiveOpacity;
+        for (int m = 2; m >= 1; --m) {
+            const float M = float(1 << m);
+            if ((1 << m) > settings.maxStepMultiple) continue;
+            const float tmin = std::pow(1.0f - amin, M), tmax = std::pow(1.0f - amax, M);
+            if (tmin - tmax <= eps && dc * (1.0f - tmax) <= eps) return m;
+        }
+        return 0;
     }
     // Chebyshev distance (in sub-bricks, capped at kMaxDistance) from each skipped sub-brick
     // to the nearest one that is not: all sub-bricks closer than that are skipped too. Grows the

@@ -396,6 +396,37 @@ TEST(VolumeAdaptiveSteps, VaryingOpacityMarchesPlainly) {
     }
 }
 
+// A brick whose value range is too wide for long steps may hold sub-bricks whose own range
+// allows them: along z, every brick is homogeneous (value 50, opacity 0.02) in its voxel
+// layers 0-4, the lower sub-brick, and steep (values 150 / 200 / 250 under an opacity ramp
+// 0 -> 0.2) in layers 5-7. The lower sub-brick's samples take long steps that end at its
+// exit (at step 1: one sample for four there, 5 a brick instead of 8), the steep ones
+// march plainly, and the transmittance stays that of the plain march: the homogeneous long
+// steps are exact up to the half-float opacity tables (|log T| within 2e-3).
+TEST(VolumeAdaptiveSteps, SubBricksOfMixedBricksTakeLongSteps) {
+    VolumeGrid grid = makeSlab(9, 9, 65, 0, 64, 0);
+    const uint8_t steep[3] = {150, 200, 250};
+    for (int k = 0; k < 65; ++k)
+        for (int j = 0; j < 9; ++j)
+            for (int i = 0; i < 9; ++i) grid.bytes[grid.index(i, j, k)] = k % 8 <= 4 ? 50 : steep[k % 8 - 5];
+    const BrickedVolume g = brickVolume(grid);
+    TransferFunction tf;
+    tf.colors = {{0.0f, {1, 1, 1}}, {1.0f, {1, 1, 1}}};
+    tf.opacity = {{0.0f, 0.02f}, {0.4f, 0.02f}, {0.6f, 0.0f}, {1.0f, 0.2f}};
+    for (float step : {1.0f, 0.5f}) {
+        const TFTable table = buildTable(tf, {0, 255}, step);
+        const auto [Ta, na] = marchTransmittance(g, table, step, 4);
+        const auto [Tp, np] = marchTransmittance(g, table, step, 1);
+        EXPECT_LT(Tp[0], 0.5f) << "step " << step;  // both parts are visible
+        for (int i = 0; i < kW; ++i)
+            EXPECT_LE(std::fabs(std::log(Ta[size_t(i)]) - std::log(Tp[size_t(i)])), 2e-3f) << "step " << step;
+        EXPECT_LE(double(na), 0.7 * double(np)) << "step " << step;
+        if (step == 1.0f) {
+            EXPECT_EQ(na * 8, np * 5);
+        }
+    }
+}
+
 // On the phantom with a faint TF (at most 0.002 per voxel: every visible brick takes 4
 // steps at once) the adaptive march takes under 40% of the plain march's samples and stays
 // within 40 dB (linear RGB, peak 1) of it at the same step, in DVR and shaded DVR, with the
