@@ -23,10 +23,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// One directory per test process, removed when the process exits.
 fs::path tmpDir() {
-    const fs::path d = fs::temp_directory_path() / ("rtfact_points_io_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
+    struct Dir {
+        fs::path path = fs::temp_directory_path() / ("rtfact_points_io_" + std::to_string(::getpid()));
+        ~Dir() {
+            std::error_code ec;
+            fs::remove_all(path, ec);
+        }
+    };
+    static const Dir d;
+    fs::create_directories(d.path);
+    return d.path;
 }
 std::string writeFile(const std::string& name, const std::string& bytes) {
     const fs::path p = tmpDir() / name;
