@@ -36,8 +36,27 @@ struct VolumeIntegrator {
         for (int k = 0; k < C; k += G) {
             Vec3<G * W> col;
             Packet<G * W> alpha, depth;
-            march<G * W, L>(s, group<G * W>(rays.org, k), group<G * W>(rays.dir, k), group<G * W>(rays.tMin, k),
-                            group<G * W>(rays.tMax, k), group<G * W>(active, k), col, alpha, depth, samples, skipped);
+            // The mode is fixed at compile time: the other modes' state and branches drop out
+            // of the loop, whose values do not fit the registers (fewer of them, fewer spills).
+            auto marchIn = [&]<VolumeMode M>() {
+                march<G * W, L, M>(s, group<G * W>(rays.org, k), group<G * W>(rays.dir, k), group<G * W>(rays.tMin, k),
+                                   group<G * W>(rays.tMax, k), group<G * W>(active, k), col, alpha, depth, samples,
+                                   skipped);
+            };
+            switch (s.settings.mode) {
+                case VolumeMode::DVR:
+                    marchIn.template operator()<VolumeMode::DVR>();
+                    break;
+                case VolumeMode::Shaded:
+                    marchIn.template operator()<VolumeMode::Shaded>();
+                    break;
+                case VolumeMode::MIP:
+                    marchIn.template operator()<VolumeMode::MIP>();
+                    break;
+                case VolumeMode::Iso:
+                    marchIn.template operator()<VolumeMode::Iso>();
+                    break;
+            }
             for (int j = 0; j < G; ++j) {
                 r.color.setChunk(k + j, col.chunk(j));
                 r.alpha.chunk(k + j) = alpha.chunk(j);
@@ -144,13 +163,12 @@ struct VolumeIntegrator {
         return toInt(tfEntry<W>(s, v));
     }
 
-    template <int W, VoxelLayout L, class Scene>
+    template <int W, VoxelLayout L, VolumeMode mode, class Scene>
     void march(const Scene& s, const Vec3<W>& o, const Vec3<W>& d, const Packet<W>& tMin, const Packet<W>& tMax,
                const Mask<W>& act, Vec3<W>& col, Packet<W>& alpha, Packet<W>& depth, uint64_t& samples,
                float& skipped) const {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
-        const VolumeMode mode = s.settings.mode;
         const bool adaptive = (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) && s.settings.maxStepMultiple > 1;
         // Rays into index space; t stays the world distance.
         const Vec3<W> oi = (o - Vec3<W>(s.origin)) * Vec3<W>(s.invSpacing);
@@ -276,7 +294,7 @@ struct VolumeIntegrator {
             {
                 Mask<W> empty;
                 P tExit;  // where the lanes' empty cube ends (computed when one is empty)
-                if (mode == VolumeMode::MIP) {
+                if constexpr (mode == VolumeMode::MIP) {
                     const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
                     empty = alive & (gather(s.cellMax.data(), cid) <= maxv);
                     if (any(empty)) tExit = cubeExit(c, I(1), invBrick);
@@ -327,7 +345,7 @@ struct VolumeIntegrator {
                 sampleCount = sampleCount + select(samp, I(1), I(0));
                 // sampling lanes have not moved since the brick lookup; the others are masked
                 const P v = haveStart ? sampleCell<W, L>(s, p, cell, start) : sample<W, L>(s, p);
-                if (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
+                if constexpr (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
                     // TF entries outside [tfVisibleLo, tfVisibleHi) have zero opacity: when no
                     // lane's entry is inside, the sample adds nothing (inside partly visible
                     // sub-bricks most samples are invisible) and the TF fetch is left out.
@@ -341,7 +359,7 @@ struct VolumeIntegrator {
                         const Mask<W> contrib = a > P(0.0f);
                         if (any(contrib)) {
                             Vec3<W> c(tr, tg, tb);
-                            if (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W, L>(s, p), d);
+                            if constexpr (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W, L>(s, p), d);
                             const P w = (P(1.0f) - alpha) * a;
                             col += c * w;
                             alpha += w;
@@ -349,7 +367,7 @@ struct VolumeIntegrator {
                         }
                         alive = alive & (alpha < term);
                     }
-                } else if (mode == VolumeMode::MIP) {
+                } else if constexpr (mode == VolumeMode::MIP) {
                     maxv = select(samp, max(maxv, v), maxv);
                 } else {
                     const Mask<W> cross = samp & hasPrev & ((prev < isoV) ^ (v < isoV));
@@ -385,7 +403,7 @@ struct VolumeIntegrator {
             }
             alive = alive & (t < tFar);
         }
-        if (mode == VolumeMode::MIP) {
+        if constexpr (mode == VolumeMode::MIP) {
             const Mask<W> hit = maxv > P(-kInfinity);
             const I idx = tfIndex<W>(s, select(hit, maxv, P(0.0f)));
             const Vec3<W> c(gather(s.tf.r.data(), idx), gather(s.tf.g.data(), idx), gather(s.tf.b.data(), idx));
