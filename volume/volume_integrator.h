@@ -5,6 +5,8 @@
 // same sample positions they would have reached by stepping (skipping changes nothing),
 // and lanes drop out when they leave the box or become opaque.
 #pragma once
+#include <utility>
+
 #include "core/concepts/integrator.h"
 #include "core/render/render_counters.h"
 #include "core/util/prefetch.h"
@@ -43,20 +45,12 @@ struct VolumeIntegrator {
                                    group<G * W>(rays.tMax, k), group<G * W>(active, k), col, alpha, depth, samples,
                                    skipped);
             };
-            switch (s.settings.mode) {
-                case VolumeMode::DVR:
-                    marchIn.template operator()<VolumeMode::DVR>();
-                    break;
-                case VolumeMode::Shaded:
-                    marchIn.template operator()<VolumeMode::Shaded>();
-                    break;
-                case VolumeMode::MIP:
-                    marchIn.template operator()<VolumeMode::MIP>();
-                    break;
-                case VolumeMode::Iso:
-                    marchIn.template operator()<VolumeMode::Iso>();
-                    break;
+            // the settings' mode as a template argument (VolumeMode's values are 0 .. 3)
+            static_assert(int(VolumeMode::Iso) == 3);
+            [&]<int... M>(std::integer_sequence<int, M...>) {
+                ((int(s.settings.mode) == M && (marchIn.template operator()<VolumeMode(M)>(), true)) || ...);
             }
+            (std::make_integer_sequence<int, 4>{});
             for (int j = 0; j < G; ++j) {
                 r.color.setChunk(k + j, col.chunk(j));
                 r.alpha.chunk(k + j) = alpha.chunk(j);
