@@ -68,8 +68,7 @@ struct LoDWideIntersector {
     using P = Packet<K>;
 
     static RTFACT_INLINE void prefetchNode(const LoDWideBVH& bvh, int32_t n) {
-        const char* p = reinterpret_cast<const char*>(bvh.nodes.data() + n);
-        for (size_t o = 0; o < sizeof(WideBVHNode<K>); o += 64) __builtin_prefetch(p + o);
+        prefetchBytes(bvh.nodes.data() + n, sizeof(WideBVHNode<K>));
         // The radii decide the cut; the rest of the summaries only when a child is cut.
         __builtin_prefetch(bvh.childReps[size_t(n)].radius);
     }

@@ -203,15 +203,16 @@ struct VolumeScene {
         const bool dvr = settings.mode == VolumeMode::DVR || settings.mode == VolumeMode::Shaded;
         if (!dvr || settings.maxStepMultiple < 2) return out;
         const TFRangeExtrema extrema(tf);
-        std::vector<int8_t> brickM(v.brickCount(), -1);  // -1: not computed yet
-        auto stored = [&](float x) { return x * v.scale + v.offset; };
+        // each brick's multiple once (-1: not computed yet); ranges in data units
+        std::vector<int8_t> brickM(v.brickCount(), -1);
+        auto value = [&](float stored) { return stored * v.scale + v.offset; };
         for (size_t i = 0; i < ns; ++i) {
             if (!visible[i]) continue;
             const auto [b, o] = brickOctant(i);
-            if (brickM[b] < 0) brickM[b] = int8_t(stepMultiple(extrema, stored(v.cellLo[b]), stored(v.cellHi[b])));
+            if (brickM[b] < 0) brickM[b] = int8_t(stepMultiple(extrema, value(v.cellLo[b]), value(v.cellHi[b])));
             if (brickM[b] > 0) {
                 out[i] = int32_t(brickM[b]) << 28;
-            } else if (const int m = stepMultiple(extrema, stored(v.subLo[b * 8 + o]), stored(v.subHi[b * 8 + o]))) {
+            } else if (const int m = stepMultiple(extrema, value(v.subLo[b * 8 + o]), value(v.subHi[b * 8 + o]))) {
                 out[i] = (m << 28) | kSubScopeBit;
             }
         }

@@ -125,8 +125,7 @@ struct WideBVHIntersector {
 
     template <int K>
     static RTFACT_INLINE void prefetchNode(const WideBVHNode<K>* n) {
-        const char* p = reinterpret_cast<const char*>(n);
-        for (size_t o = 0; o < sizeof(WideBVHNode<K>); o += 64) __builtin_prefetch(p + o);
+        prefetchBytes(n, sizeof(WideBVHNode<K>));
     }
 
     // The first block of a leaf that will be visited (block leaves are read whole, and
