@@ -5,12 +5,6 @@
 
 namespace rtfact {
 
-struct Region {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // half-open pixel rectangle
-    int width() const { return x1 - x0; }
-    int height() const { return y1 - y0; }
-};
-
 template <class R, class Scene, class Cam, class FB>
 concept Renderer = Camera<Cam> && Framebuffer<FB> &&
     requires(const R& r, const Scene& s, const Cam& c, FB& fb, Region region) {

@@ -1,6 +1,7 @@
 // Float RGBA framebuffer with an optional depth channel; samples accumulate, so
 // progressive rendering is the sum divided by the sample count.
 #pragma once
+#include <algorithm>
 #include <vector>
 
 #include "core/concepts/framebuffer.h"
@@ -45,6 +46,16 @@ class RGBAFramebuffer {
     }
     // Colours only: the depth keeps its minimum over the passes of one accumulation.
     void clearColor() { std::fill(rgba_.begin(), rgba_.end(), 0.0f); }
+    // The pixels of r (clipped to the image); the depth too when depthToo.
+    void clear(const Region& r, bool depthToo) {
+        const int x0 = std::max(r.x0, 0), x1 = std::min(r.x1, w_);
+        if (x0 >= x1) return;
+        for (int y = std::max(r.y0, 0); y < std::min(r.y1, h_); ++y) {
+            const size_t p = size_t(y) * size_t(w_);
+            std::fill(&rgba_[(p + size_t(x0)) * 4], &rgba_[(p + size_t(x1)) * 4], 0.0f);
+            if (depthToo && !depth_.empty()) std::fill(&depth_[p + size_t(x0)], &depth_[p + size_t(x1)], kInfinity);
+        }
+    }
 
    private:
     int w_, h_;

@@ -62,6 +62,57 @@ std::string refPath(const std::string& name) { return std::string(RTFACT_TEST_DA
 
 }  // namespace
 
+// Tiles clear their pixels before their first sample (RenderOptions::clear): rendering into
+// a framebuffer that holds another image gives the image of a fresh one; without the clear the
+// samples add to the old ones. Clear::Color keeps the depth (its minimum over passes).
+TEST(Render, TilesClearTheirPixelsBeforeTheFirstSample) {
+    const PinholeCamera cam(frame(), kW, kH);
+    RayTracingRenderer<JitteredSampler, EyeLightIntegrator> r{};
+    RenderOptions o;
+    o.progress = false;
+    o.tileSize = 16;
+    RGBAFramebuffer fresh(kW, kH, true);
+    renderImage<simd::kNativeWidth>(r, scene(), cam, fresh, o);
+    for (const auto clear : {RenderOptions::Clear::None, RenderOptions::Clear::Color,
+                             RenderOptions::Clear::ColorAndDepth}) {
+        RGBAFramebuffer fb(kW, kH, true);
+        CameraFrame other = frame();
+        other.eye = {5.0f, 3.0f, -6.0f};
+        renderImage<simd::kNativeWidth>(r, scene(), PinholeCamera(other, kW, kH), fb, o);
+        const std::vector<float> otherDepth = fb.depth();
+        RenderOptions c = o;
+        c.clear = clear;
+        c.threads = 2;
+        renderImage<simd::kNativeWidth>(r, scene(), cam, fb, c);
+        if (clear == RenderOptions::Clear::None) {
+            EXPECT_NE(fb.resolved(1), fresh.resolved(1));
+            continue;
+        }
+        EXPECT_EQ(fb.resolved(1), fresh.resolved(1)) << "clear " << int(clear);
+        if (clear == RenderOptions::Clear::ColorAndDepth) {
+            EXPECT_EQ(fb.depth(), fresh.depth());
+        } else {
+            size_t nearer = 0;  // pixels where the other view's depth is the minimum
+            for (size_t i = 0; i < otherDepth.size(); ++i) {
+                ASSERT_EQ(fb.depth()[i], std::min(otherDepth[i], fresh.depth()[i])) << "pixel " << i;
+                nearer += otherDepth[i] < fresh.depth()[i];
+            }
+            EXPECT_GT(nearer, 100u);
+        }
+    }
+    // A region clear touches only that region (clipped to the image).
+    RGBAFramebuffer fb = fresh;
+    fb.clear(Region{kW - 8, 4, kW + 8, 12}, true);
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            const size_t p = size_t(y) * kW + size_t(x);
+            const bool in = x >= kW - 8 && y >= 4 && y < 12;
+            for (int c = 0; c < 4; ++c)
+                ASSERT_EQ(fb.rawRGBA()[p * 4 + c], in ? 0.0f : fresh.rawRGBA()[p * 4 + c]) << x << "," << y;
+            ASSERT_EQ(fb.depth()[p], in ? kInfinity : fresh.depth()[p]) << x << "," << y;
+        }
+}
+
 TEST(Render, PacketBlockShapes) {
     EXPECT_EQ(packetBlockWidth(1), 1);
     EXPECT_EQ(packetBlockWidth(4), 2);

@@ -209,3 +209,27 @@ TEST(RenderSession, CancelFromAnotherThreadStopsWithinOneTile) {
     EXPECT_EQ(session.renderPass().samples, 2);
     EXPECT_EQ(session.frame().rgba, oneShot(bunny(), ao(), size(128, 128), cam, 2).rgba);
 }
+
+// Each tile clears its own pixels as it renders them: a first pass of a new camera that is
+// cancelled part way leaves the old camera's colours and depth in the tiles it did not
+// reach, and the next pass must still give the new camera's image, eye-dome lighting (from
+// the depth) included.
+TEST(RenderSession, CancelledFirstPassLeavesNoStaleDepth) {
+    const Scene pts = openQuiet(kPoints);
+    const Settings st;  // a cloud without normals: eye-dome lighting on, so a depth channel
+    const CameraFrame camA = cameraOf(pts, {0.6f, 0.45f, 1.0f}), camB = cameraOf(pts, {-1.0f, 0.2f, -0.3f});
+    RenderSession session(pts, st, size(128, 128, 1), camA);
+    EXPECT_EQ(session.renderPass().status, PassResult::Status::Done);
+    session.setCamera(camB);
+    session.onProgress([&](uint64_t done, uint64_t) {
+        if (done == 3) session.cancel();
+    });
+    EXPECT_EQ(session.renderPass().status, PassResult::Status::Cancelled);
+    EXPECT_EQ(session.samples(), 0);
+    session.onProgress(nullptr);
+    EXPECT_EQ(session.renderPass().samples, 1);
+    const Frame f = session.frame();
+    const Frame b = oneShot(pts, st, size(128, 128), camB, 1);
+    ASSERT_EQ(f.rgba.size(), b.rgba.size());
+    EXPECT_EQ(f.rgba, b.rgba);
+}
