@@ -32,30 +32,43 @@ struct VolumeIntegrator {
         Radiance<N> r;
         uint64_t samples = 0;
         float skipped = 0;
-        // Two native chunks march together when the packet has them: their gather chains
-        // (brick, voxels, TF) are independent, so each hides the other's latency.
-        constexpr int W = Packet<N>::W, C = Packet<N>::C, G = C % 2 == 0 ? 2 : 1;
-        for (int k = 0; k < C; k += G) {
-            Vec3<G * W> col;
-            Packet<G * W> alpha, depth;
-            // The mode is fixed at compile time: the other modes' state and branches drop out
-            // of the loop, whose values do not fit the registers (fewer of them, fewer spills).
-            auto marchIn = [&]<VolumeMode M>() {
-                march<G * W, L, M>(s, group<G * W>(rays.org, k), group<G * W>(rays.dir, k), group<G * W>(rays.tMin, k),
-                                   group<G * W>(rays.tMax, k), group<G * W>(active, k), col, alpha, depth, samples,
-                                   skipped);
-            };
-            // the settings' mode as a template argument (VolumeMode's values are 0 .. 3)
-            static_assert(int(VolumeMode::Iso) == 3);
-            [&]<int... M>(std::integer_sequence<int, M...>) {
-                ((int(s.settings.mode) == M && (marchIn.template operator()<VolumeMode(M)>(), true)) || ...);
+        // Four native chunks (two when the packet has fewer) march together: their gather
+        // chains (brick, voxels, TF) are independent, so each hides the others' latency. Eight
+        // AVX2 chunks spill too much; volumes larger than the caches (brick prefetches) march
+        // faster on AVX2 in pairs, where fewer lanes wait for the longest ray of the group.
+        constexpr int W = Packet<N>::W, C = Packet<N>::C, G = C % 4 == 0 ? 4 : C % 2 == 0 ? 2 : 1;
+        auto groups = [&]<int GG>() {
+            for (int k = 0; k < C; k += GG) {
+                Vec3<GG * W> col;
+                Packet<GG * W> alpha, depth;
+                // The mode is fixed at compile time: the other modes' state and branches drop out
+                // of the loop, whose values do not fit the registers (fewer of them, fewer spills).
+                auto marchIn = [&]<VolumeMode M>() {
+                    march<GG * W, L, M>(s, group<GG * W>(rays.org, k), group<GG * W>(rays.dir, k),
+                                        group<GG * W>(rays.tMin, k), group<GG * W>(rays.tMax, k),
+                                        group<GG * W>(active, k), col, alpha, depth, samples, skipped);
+                };
+                // the settings' mode as a template argument (VolumeMode's values are 0 .. 3)
+                static_assert(int(VolumeMode::Iso) == 3);
+                [&]<int... M>(std::integer_sequence<int, M...>) {
+                    ((int(s.settings.mode) == M && (marchIn.template operator()<VolumeMode(M)>(), true)) || ...);
+                }
+                (std::make_integer_sequence<int, 4>{});
+                for (int j = 0; j < GG; ++j) {
+                    r.color.setChunk(k + j, col.chunk(j));
+                    r.alpha.chunk(k + j) = alpha.chunk(j);
+                    r.depth.chunk(k + j) = depth.chunk(j);
+                }
             }
-            (std::make_integer_sequence<int, 4>{});
-            for (int j = 0; j < G; ++j) {
-                r.color.setChunk(k + j, col.chunk(j));
-                r.alpha.chunk(k + j) = alpha.chunk(j);
-                r.depth.chunk(k + j) = depth.chunk(j);
+        };
+        if constexpr (W == 8 && G == 4) {
+            if (s.prefetchBricks) {
+                groups.template operator()<2>();
+            } else {
+                groups.template operator()<4>();
             }
+        } else {
+            groups.template operator()<G>();
         }
         tlsCounters.volumeSamples += samples;
         tlsCounters.volumeSkipped += uint64_t(skipped);
