@@ -73,8 +73,8 @@ TEST(Render, TilesClearTheirPixelsBeforeTheFirstSample) {
     o.tileSize = 16;
     RGBAFramebuffer fresh(kW, kH, true);
     renderImage<simd::kNativeWidth>(r, scene(), cam, fresh, o);
-    for (const auto clear : {RenderOptions::Clear::None, RenderOptions::Clear::Color,
-                             RenderOptions::Clear::ColorAndDepth}) {
+    for (const auto clear :
+         {RenderOptions::Clear::None, RenderOptions::Clear::Color, RenderOptions::Clear::ColorAndDepth}) {
         RGBAFramebuffer fb(kW, kH, true);
         CameraFrame other = frame();
         other.eye = {5.0f, 3.0f, -6.0f};
