@@ -34,26 +34,21 @@ struct VolumeIntegrator {
         float skipped = 0;
         // Four native chunks (two when the packet has fewer) march together: their gather
         // chains (brick, voxels, TF) are independent, so each hides the others' latency. Eight
-        // AVX2 chunks spill too much; volumes larger than the caches (brick prefetches) march
-        // faster on AVX2 in pairs, where fewer lanes wait for the longest ray of the group.
+        // AVX2 chunks spill too much. Pairs where more lanes cost more than they hide (measured):
+        // isosurfaces (a crossing in any lane bisects all), and on AVX2 MIP (a short step: the
+        // spills weigh more) and volumes larger than the caches (brick prefetches; fewer lanes
+        // wait for the longest ray of the group).
         constexpr int W = Packet<N>::W, C = Packet<N>::C, G = C % 4 == 0 ? 4 : C % 2 == 0 ? 2 : 1;
-        auto groups = [&]<int GG>() {
+        constexpr int G2 = G == 4 ? 2 : G;
+        // The mode is fixed at compile time: the other modes' state and branches drop out of
+        // the loop, whose values do not fit the registers (fewer of them, fewer spills).
+        auto marchGroups = [&]<int GG, VolumeMode M>() {
             for (int k = 0; k < C; k += GG) {
                 Vec3<GG * W> col;
                 Packet<GG * W> alpha, depth;
-                // The mode is fixed at compile time: the other modes' state and branches drop out
-                // of the loop, whose values do not fit the registers (fewer of them, fewer spills).
-                auto marchIn = [&]<VolumeMode M>() {
-                    march<GG * W, L, M>(s, group<GG * W>(rays.org, k), group<GG * W>(rays.dir, k),
-                                        group<GG * W>(rays.tMin, k), group<GG * W>(rays.tMax, k),
-                                        group<GG * W>(active, k), col, alpha, depth, samples, skipped);
-                };
-                // the settings' mode as a template argument (VolumeMode's values are 0 .. 3)
-                static_assert(int(VolumeMode::Iso) == 3);
-                [&]<int... M>(std::integer_sequence<int, M...>) {
-                    ((int(s.settings.mode) == M && (marchIn.template operator()<VolumeMode(M)>(), true)) || ...);
-                }
-                (std::make_integer_sequence<int, 4>{});
+                march<GG * W, L, M>(s, group<GG * W>(rays.org, k), group<GG * W>(rays.dir, k),
+                                    group<GG * W>(rays.tMin, k), group<GG * W>(rays.tMax, k),
+                                    group<GG * W>(active, k), col, alpha, depth, samples, skipped);
                 for (int j = 0; j < GG; ++j) {
                     r.color.setChunk(k + j, col.chunk(j));
                     r.alpha.chunk(k + j) = alpha.chunk(j);
@@ -61,15 +56,24 @@ struct VolumeIntegrator {
                 }
             }
         };
-        if constexpr (W == 8 && G == 4) {
-            if (s.prefetchBricks) {
-                groups.template operator()<2>();
+        auto marchMode = [&]<VolumeMode M>() {
+            if constexpr (M == VolumeMode::Iso || (W == 8 && M == VolumeMode::MIP)) {
+                marchGroups.template operator()<G2, M>();
+            } else if constexpr (W == 8 && G != G2) {
+                if (s.prefetchBricks)
+                    marchGroups.template operator()<G2, M>();
+                else
+                    marchGroups.template operator()<G, M>();
             } else {
-                groups.template operator()<4>();
+                marchGroups.template operator()<G, M>();
             }
-        } else {
-            groups.template operator()<G>();
+        };
+        // the settings' mode as a template argument (VolumeMode's values are 0 .. 3)
+        static_assert(int(VolumeMode::Iso) == 3);
+        [&]<int... M>(std::integer_sequence<int, M...>) {
+            ((int(s.settings.mode) == M && (marchMode.template operator()<VolumeMode(M)>(), true)) || ...);
         }
+        (std::make_integer_sequence<int, 4>{});
         tlsCounters.volumeSamples += samples;
         tlsCounters.volumeSkipped += uint64_t(skipped);
         return r;
