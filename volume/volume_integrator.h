@@ -47,8 +47,8 @@ struct VolumeIntegrator {
                 Vec3<GG * W> col;
                 Packet<GG * W> alpha, depth;
                 march<GG * W, L, M>(s, group<GG * W>(rays.org, k), group<GG * W>(rays.dir, k),
-                                    group<GG * W>(rays.tMin, k), group<GG * W>(rays.tMax, k),
-                                    group<GG * W>(active, k), col, alpha, depth, samples, skipped);
+                                    group<GG * W>(rays.tMin, k), group<GG * W>(rays.tMax, k), group<GG * W>(active, k),
+                                    col, alpha, depth, samples, skipped);
                 for (int j = 0; j < GG; ++j) {
                     r.color.setChunk(k + j, col.chunk(j));
                     r.alpha.chunk(k + j) = alpha.chunk(j);
