@@ -173,12 +173,10 @@ PassResult RenderSession::renderSamples(int n) {
         // tiles it did not reach).
         using Clear = RenderOptions::Clear;
         const Clear clear = resize ? Clear::None : samples_ == 0 ? Clear::ColorAndDepth : Clear::Color;
-        if (opts_.nextTile && clear == Clear::ColorAndDepth)
-            first_->clear();
-        else if (opts_.nextTile && clear == Clear::Color)
-            first_->clearColor();
-        else
+        if (!opts_.nextTile)
             ro.clear = clear;
+        else if (clear != Clear::None)
+            first_->clear(Region{0, 0, w, h}, clear == Clear::ColorAndDepth);
         ro.firstSample = samples_;
     }
     ro.threads = opts_.threads;

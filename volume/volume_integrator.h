@@ -59,7 +59,7 @@ struct VolumeIntegrator {
         auto marchMode = [&]<VolumeMode M>() {
             if constexpr (M == VolumeMode::Iso || (W == 8 && M == VolumeMode::MIP)) {
                 marchGroups.template operator()<G2, M>();
-            } else if constexpr (W == 8 && G != G2) {
+            } else if constexpr (W == 8) {
                 if (s.prefetchBricks)
                     marchGroups.template operator()<G2, M>();
                 else

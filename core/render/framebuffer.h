@@ -40,13 +40,8 @@ class RGBAFramebuffer {
         return out;
     }
     const std::vector<float>& depth() const { return depth_; }
-    void clear() {
-        std::fill(rgba_.begin(), rgba_.end(), 0.0f);
-        std::fill(depth_.begin(), depth_.end(), kInfinity);
-    }
-    // Colours only: the depth keeps its minimum over the passes of one accumulation.
-    void clearColor() { std::fill(rgba_.begin(), rgba_.end(), 0.0f); }
-    // The pixels of r (clipped to the image); the depth too when depthToo.
+    // The pixels of r (clipped to the image); the depth too when depthToo (without it the
+    // depth keeps its minimum over the passes of one accumulation).
     void clear(const Region& r, bool depthToo) {
         const int x0 = std::max(r.x0, 0), x1 = std::min(r.x1, w_);
         if (x0 >= x1) return;
