@@ -98,6 +98,12 @@ struct VolumeIntegrator {
         for (int i = 0; i < Packet<W, int32_t>::C; ++i) r.c[i] = a.c[i] >> k;
         return r;
     }
+    template <int W>
+    static RTFACT_INLINE Packet<W, int32_t> shiftLeft(const Packet<W, int32_t>& a, int k) {
+        Packet<W, int32_t> r;
+        for (int i = 0; i < Packet<W, int32_t>::C; ++i) r.c[i] = a.c[i] << k;
+        return r;
+    }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
     template <int W, VoxelLayout L = VoxelLayout::Rows, class Scene>
     static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p) {
@@ -150,6 +156,40 @@ struct VolumeIntegrator {
             hi[a] = hi[a] + Packet<W>(1.0f);
             g[a] = (sample<W, L>(s, clampToGrid<W>(s, hi)) - sample<W, L>(s, clampToGrid<W>(s, lo))) *
                    Packet<W>(0.5f * s.invSpacing[a]);
+        }
+        return g;
+    }
+    // The same from the gradient bricks (VolumeScene::gradients: non-empty), for p in cell
+    // `cell` of brick `brick`: the trilinear interpolation of the cell's eight central
+    // differences, 9 gathers instead of six samples' 18 and their arithmetic.
+    template <int W, class Scene>
+    static RTFACT_INLINE Vec3<W> gradientFromBricks(const Scene& s, const Vec3<W>& p, const Packet<W, int32_t> (&cell)[3],
+                                                    const Packet<W, int32_t> (&brick)[3]) {
+        using P = Packet<W>;
+        using I = Packet<W, int32_t>;
+        constexpr int E = Scene::kEdge, B = GradientBricks::kFieldBits;
+        const I id = brick[0] + brick[1] * I(s.nbx) + brick[2] * I(s.nbxy);
+        const I base = gather(s.gradients.start.data(), id) + (cell[0] & I(7)) + (cell[1] & I(7)) * I(E) +
+                       (cell[2] & I(7)) * I(E * E);
+        const P fx = p.x - toFloat(cell[0]), fy = p.y - toFloat(cell[1]), fz = p.z - toFloat(cell[2]);
+        // corner (x, y, z) of the cell: entry base + x + E y + E^2 z
+        Vec3<W> row[4];  // the x-lerps of rows (y, z) = (0, 0), (1, 0), (0, 1), (1, 1)
+        for (int r = 0; r < 4; ++r) {
+            const int off = (r & 1) * E + (r >> 1) * E * E;
+            const I e0 = gather(s.gradients.entries.data(), base + I(off));
+            const I e1 = gather(s.gradients.entries.data(), base + I(off + 1));
+            for (int a = 0; a < 3; ++a) {
+                // field a sign-extended: to the top bits, then an arithmetic shift down
+                const int up = 32 - B * (a + 1);
+                const P a0 = toFloat(shiftRight<W>(shiftLeft<W>(e0, up), 32 - B));
+                const P a1 = toFloat(shiftRight<W>(shiftLeft<W>(e1, up), 32 - B));
+                row[r][a] = a0 + (a1 - a0) * fx;
+            }
+        }
+        Vec3<W> g;
+        for (int a = 0; a < 3; ++a) {
+            const P d0 = row[0][a] + (row[1][a] - row[0][a]) * fy, d1 = row[2][a] + (row[3][a] - row[2][a]) * fy;
+            g[a] = (d0 + (d1 - d0) * fz) * P(0.5f * s.invSpacing[a]);
         }
         return g;
     }
@@ -369,10 +409,14 @@ struct VolumeIntegrator {
                         const P a = select(seen, ta, P(0.0f));
                         const Mask<W> contrib = a > P(0.0f);
                         if (any(contrib)) {
-                            Vec3<W> c(tr, tg, tb);
-                            if constexpr (mode == VolumeMode::Shaded) c = c * shadeFactor<W>(gradient<W, L>(s, p), d);
+                            Vec3<W> rgb(tr, tg, tb);
+                            if constexpr (mode == VolumeMode::Shaded) {
+                                const Vec3<W> g = !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c)
+                                                                       : gradient<W, L>(s, p);
+                                rgb = rgb * shadeFactor<W>(g, d);
+                            }
                             const P w = (P(1.0f) - alpha) * a;
-                            col += c * w;
+                            col += rgb * w;
                             alpha += w;
                             depth = select(contrib & (depth == P(kInfinity)), t, depth);
                         }

@@ -6,10 +6,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "core/util/error.h"
+#include "core/util/memory_budget.h"
 #include "volume/brick_volume.h"
+#include "volume/gradient_bricks.h"
 #include "volume/half_float.h"
 #include "volume/tf_range_extrema.h"
 #include "volume/transfer_function.h"
@@ -102,6 +105,11 @@ struct VolumeScene {
     // is larger than the last-level caches, where it waits on memory at every new brick.
     static constexpr size_t kPrefetchPoolBytes = size_t(64) << 20;
     bool prefetchBricks = false;
+    // Shaded u8 volumes: the voxels' central differences, per brick the TF shows (empty
+    // otherwise, or beyond kMaxGradientBytes and a quarter of the available memory: the
+    // march then takes six trilinear samples a gradient).
+    static constexpr uint64_t kMaxGradientBytes = uint64_t(1) << 30;
+    GradientBricks gradients;
 
     VolumeScene(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& s) : settings(s), tf(table) {
         for (int a = 0; a < 3; ++a) {
@@ -157,6 +165,12 @@ struct VolumeScene {
             }
             visible[i] = on ? 1 : 0;
             subFlags[i] = (on || !s.skipping) ? 1 : 0;
+        }
+        if (s.mode == VolumeMode::Shaded && std::is_same_v<T, uint8_t>) {
+            std::vector<uint8_t> shown(nc, 0);
+            for (size_t i = 0; i < ns; ++i)
+                if (visible[i]) shown[brickOctant(i).first] = 1;
+            gradients = GradientBricks::build(v, shown, std::min(kMaxGradientBytes, availableMemoryBytes() / 4));
         }
         subInfo.resize(ns);
         const std::vector<int32_t> steps = stepBits(v, visible);

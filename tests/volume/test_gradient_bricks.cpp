@@ -1,0 +1,179 @@
+// Gradient bricks (volume/gradient_bricks.h): their entries are the clamped central
+// differences of the voxels (brute force over BrickedVolume::stored), the gradient read from
+// them equals the six-sample gradient at random positions (widths 1 and native, brick faces
+// and the grid's border included), and shaded images with and without them match.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/render/framebuffer.h"
+#include "core/render/pinhole_camera.h"
+#include "core/render/pixel_center_sampler.h"
+#include "core/render/ray_tracing_renderer.h"
+#include "core/render/tile_scheduler.h"
+#include "volume/gradient_bricks.h"
+#include "volume/volume_generators.h"
+#include "volume/volume_integrator.h"
+#include "volume/volume_scene.h"
+
+using namespace rtfact;
+using namespace rtfact::volume;
+
+namespace {
+
+constexpr int kW = simd::kNativeWidth;
+
+// Random u8 voxels, sizes no brick multiple, and a zero corner (bricks sharing brick 0).
+BrickedVolume randomVolume() {
+    VolumeGrid g;
+    g.dims[0] = 37;
+    g.dims[1] = 26;
+    g.dims[2] = 19;
+    g.allocate(Storage::U8);
+    std::mt19937 rng(3);
+    std::uniform_int_distribution<int> u(0, 255);
+    for (size_t n = 0; n < g.voxelCount(); ++n) g.data<uint8_t>()[n] = uint8_t(u(rng));
+    for (int k = 0; k < 9; ++k)
+        for (int j = 0; j < 9; ++j)
+            for (int i = 0; i < 17; ++i) g.data<uint8_t>()[g.index(i, j, k)] = 0;
+    return brickVolume(g);
+}
+
+VolumeScene<uint8_t> shadedScene(const BrickedVolume& bv, bool skipping = true) {
+    VolumeRenderSettings rs;
+    rs.mode = VolumeMode::Shaded;
+    rs.skipping = skipping;
+    const auto [lo, hi] = bv.valueRange();
+    return VolumeScene<uint8_t>(bv, buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, rs.stepVoxels), rs);
+}
+
+template <int W>
+Vec3<W> bothGradients(const VolumeScene<uint8_t>& s, const Vec3<W>& q, Vec3<W>& six) {
+    using I = Packet<W, int32_t>;
+    const Vec3<W> p = VolumeIntegrator::clampToGrid<W>(s, q);
+    const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
+    const I brick[3] = {VolumeIntegrator::shiftRight<W>(cell[0], 3), VolumeIntegrator::shiftRight<W>(cell[1], 3),
+                        VolumeIntegrator::shiftRight<W>(cell[2], 3)};
+    six = VolumeIntegrator::gradient<W>(s, p);
+    return VolumeIntegrator::gradientFromBricks<W>(s, p, cell, brick);
+}
+
+std::vector<float> render(const VolumeScene<uint8_t>& scene, int n) {
+    const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}), n, n);
+    RGBAFramebuffer fb(n, n);
+    RenderOptions ro;
+    ro.progress = false;
+    renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+    return fb.resolved(1);
+}
+
+}  // namespace
+
+TEST(GradientBricks, PackedFieldsRoundTrip) {
+    for (int x : {-255, -1, 0, 1, 254, 255})
+        for (int y : {-255, -7, 0, 200})
+            for (int z : {-255, 0, 3, 255}) {
+                const int32_t e = GradientBricks::pack(x, y, z);
+                EXPECT_EQ(GradientBricks::unpack(e, 0), x);
+                EXPECT_EQ(GradientBricks::unpack(e, 1), y);
+                EXPECT_EQ(GradientBricks::unpack(e, 2), z);
+            }
+}
+
+TEST(GradientBricks, EntriesAreClampedCentralDifferences) {
+    const BrickedVolume bv = randomVolume();
+    const size_t nb = bv.brickCount();
+    std::vector<uint8_t> shown(nb, 0);
+    for (size_t b = 0; b < nb; b += 2) shown[b] = 1;  // every other brick
+    const GradientBricks g = GradientBricks::build(bv, shown, uint64_t(1) << 30);
+    ASSERT_FALSE(g.empty());
+    ASSERT_EQ(g.start.size(), nb);
+    for (int e = 0; e < BrickedVolume::kBrick; ++e) ASSERT_EQ(g.entries[size_t(e)], 0) << "brick 0 is zeros";
+    constexpr int C = BrickedVolume::kCells, E = BrickedVolume::kEdge;
+    auto at = [&](int x, int y, int z) {
+        return int(bv.stored(std::clamp(x, 0, bv.dims[0] - 1), std::clamp(y, 0, bv.dims[1] - 1),
+                             std::clamp(z, 0, bv.dims[2] - 1)));
+    };
+    size_t checked = 0;
+    for (int bz = 0; bz < bv.nb[2]; ++bz)
+        for (int by = 0; by < bv.nb[1]; ++by)
+            for (int bx = 0; bx < bv.nb[0]; ++bx) {
+                const size_t b = bv.brickIndex(bx, by, bz);
+                if (!shown[b]) {
+                    EXPECT_EQ(g.start[b], 0);
+                    continue;
+                }
+                ASSERT_GT(g.start[b], 0);
+                for (int k = 0; k < E; ++k)
+                    for (int j = 0; j < E; ++j)
+                        for (int i = 0; i < E; ++i) {
+                            const int x = bx * C + i, y = by * C + j, z = bz * C + k;
+                            if (x >= bv.dims[0] || y >= bv.dims[1] || z >= bv.dims[2]) continue;  // never read
+                            const int32_t e = g.entries[size_t(g.start[b] + i + j * E + k * E * E)];
+                            ASSERT_EQ(GradientBricks::unpack(e, 0), at(x + 1, y, z) - at(x - 1, y, z)) << x << y << z;
+                            ASSERT_EQ(GradientBricks::unpack(e, 1), at(x, y + 1, z) - at(x, y - 1, z)) << x << y << z;
+                            ASSERT_EQ(GradientBricks::unpack(e, 2), at(x, y, z + 1) - at(x, y, z - 1)) << x << y << z;
+                            ++checked;
+                        }
+            }
+    EXPECT_GT(checked, bv.voxelCount() / 3);
+    // over budget, or not u8: none (the march takes six samples)
+    EXPECT_TRUE(GradientBricks::build(bv, shown, 1000).empty());
+    const BrickedVolume u16 = brickVolume(makeSheppLogan(20, Storage::U16));
+    EXPECT_TRUE(GradientBricks::build(u16, std::vector<uint8_t>(u16.brickCount(), 1), uint64_t(1) << 30).empty());
+}
+
+template <int W>
+void checkEqualsSixSamples() {
+    const BrickedVolume bv = randomVolume();
+    VolumeScene<uint8_t> s = shadedScene(bv);
+    ASSERT_FALSE(s.gradients.empty()) << "a shaded u8 scene has gradient bricks";
+    s.gradients = GradientBricks::build(bv, std::vector<uint8_t>(bv.brickCount(), 1), uint64_t(1) << 30);
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int it = 0; it < 300; ++it) {
+        Vec3<W> q;
+        for (int i = 0; i < W; ++i) {
+            Vec3f v(u(rng) * float(bv.dims[0] - 1), u(rng) * float(bv.dims[1] - 1), u(rng) * float(bv.dims[2] - 1));
+            if (it == 0) v[i % 3] = i % 2 ? float(bv.dims[i % 3] - 1) : 0.0f;  // the border
+            if (it == 1) v[i % 3] = float((i / 3 + 1) * 8 % (bv.dims[i % 3] - 1));  // brick faces
+            if (it == 2) v[i % 3] += 0.5f * float(i % 2 ? 1 : -1);  // within a voxel of the border
+            q.setLane(i, v);
+        }
+        Vec3<W> six;
+        const Vec3<W> fast = bothGradients<W>(s, q, six);
+        for (int i = 0; i < W; ++i)
+            for (int a = 0; a < 3; ++a)
+                ASSERT_NEAR(fast[a][i], six[a][i], 2e-3f) << "lane " << i << " axis " << a << " at " << q.x[i] << ","
+                                                          << q.y[i] << "," << q.z[i];
+    }
+}
+
+TEST(GradientBricks, EqualSixSampleGradientWidth1) { checkEqualsSixSamples<1>(); }
+TEST(GradientBricks, EqualSixSampleGradientNative) { checkEqualsSixSamples<kW>(); }
+
+// The shaded march reads the gradient bricks where the TF shows the volume (skipping on
+// or off): the image is the six-sample one's within float rounding.
+TEST(GradientBricks, ShadedImageMatchesSixSamples) {
+    const BrickedVolume bv = brickVolume(makeSheppLogan(45, Storage::U8));
+    for (bool skipping : {true, false}) {
+        VolumeScene<uint8_t> s = shadedScene(bv, skipping);
+        ASSERT_FALSE(s.gradients.empty());
+        const std::vector<float> fast = render(s, 64);
+        s.gradients = {};
+        const std::vector<float> six = render(s, 64);
+        ASSERT_EQ(fast.size(), six.size());
+        float maxDiff = 0, sum = 0;
+        for (size_t i = 0; i < fast.size(); ++i) {
+            maxDiff = std::max(maxDiff, std::fabs(fast[i] - six[i]));
+            sum += six[i];
+        }
+        EXPECT_LT(maxDiff, 1e-4f) << "skipping " << skipping;
+        EXPECT_GT(sum, 0.0f);
+    }
+    // other modes and storage types build none
+    VolumeRenderSettings dvr;
+    const auto [lo, hi] = bv.valueRange();
+    const TFTable table = buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, dvr.stepVoxels);
+    EXPECT_TRUE(VolumeScene<uint8_t>(bv, table, dvr).gradients.empty());
+}

@@ -1,0 +1,63 @@
+#include "volume/gradient_bricks.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+namespace rtfact::volume {
+
+GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<uint8_t>& brickShown,
+                                     uint64_t maxBytes) {
+    using BV = BrickedVolume;
+    GradientBricks g;
+    const size_t nb = v.brickCount();
+    if (v.storage != Storage::U8 || brickShown.size() != nb) return g;
+    // brick 0 (zeros) and the shown ones
+    const uint64_t count = uint64_t(1 + std::count_if(brickShown.begin(), brickShown.end(), [](uint8_t s) { return s; })) *
+                           uint64_t(BV::kBrick);
+    if (count * 4 > maxBytes || count + 64 > uint64_t(std::numeric_limits<int32_t>::max())) return g;
+    std::vector<int32_t> start(nb, 0);
+    int32_t next = BV::kBrick;
+    for (size_t b = 0; b < nb; ++b)
+        if (brickShown[b]) start[b] = std::exchange(next, next + BV::kBrick);
+    // + 64: wide gathers may read past the last entry
+    g.entries.assign(size_t(count) + 64, 0);
+    const uint8_t* pool = v.pool.data();
+    constexpr int E = BV::kEdge, C = BV::kCells, N = E + 2;  // N: the brick and one voxel around it
+    tbb::parallel_for(size_t(0), nb, [&](size_t b) {
+        if (!brickShown[b]) return;
+        const int bc[3] = {int(b % size_t(v.nb[0])), int(b / size_t(v.nb[0]) % size_t(v.nb[1])),
+                           int(b / (size_t(v.nb[0]) * size_t(v.nb[1])))};
+        // per axis and local position -1 .. kEdge: the voxel's brick and its place there,
+        // clamped into the grid
+        int brickOf[3][N], localOf[3][N];
+        for (int a = 0; a < 3; ++a)
+            for (int i = 0; i < N; ++i) {
+                const int x = std::clamp(bc[a] * C + i - 1, 0, v.dims[a] - 1);
+                brickOf[a][i] = std::min(x / C, v.nb[a] - 1);
+                localOf[a][i] = x - brickOf[a][i] * C;
+            }
+        uint8_t around[N * N * N];
+        for (int k = 0; k < N; ++k)
+            for (int j = 0; j < N; ++j)
+                for (int i = 0; i < N; ++i) {
+                    const size_t sb = v.brickIndex(brickOf[0][i], brickOf[1][j], brickOf[2][k]);
+                    around[(k * N + j) * N + i] =
+                        pool[size_t(v.brickStart[sb]) + size_t(localOf[0][i] + localOf[1][j] * E + localOf[2][k] * E * E)];
+                }
+        int32_t* out = g.entries.data() + start[b];
+        for (int k = 1; k <= E; ++k)
+            for (int j = 1; j <= E; ++j)
+                for (int i = 1; i <= E; ++i) {
+                    const int c = (k * N + j) * N + i;
+                    *out++ = pack(int(around[c + 1]) - int(around[c - 1]), int(around[c + N]) - int(around[c - N]),
+                                  int(around[c + N * N]) - int(around[c - N * N]));
+                }
+    });
+    g.start = std::move(start);
+    return g;
+}
+
+}  // namespace rtfact::volume
