@@ -15,8 +15,9 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
     const size_t nb = v.brickCount();
     if (v.storage != Storage::U8 || brickShown.size() != nb) return g;
     // brick 0 (zeros) and the shown ones
-    const uint64_t count = uint64_t(1 + std::count_if(brickShown.begin(), brickShown.end(), [](uint8_t s) { return s; })) *
-                           uint64_t(BV::kBrick);
+    const uint64_t count =
+        uint64_t(1 + std::count_if(brickShown.begin(), brickShown.end(), [](uint8_t s) { return s; })) *
+        uint64_t(BV::kBrick);
     if (count * 4 > maxBytes || count + 64 > uint64_t(std::numeric_limits<int32_t>::max())) return g;
     std::vector<int32_t> start(nb, 0);
     int32_t next = BV::kBrick;
@@ -45,7 +46,8 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
                 for (int i = 0; i < N; ++i) {
                     const size_t sb = v.brickIndex(brickOf[0][i], brickOf[1][j], brickOf[2][k]);
                     around[(k * N + j) * N + i] =
-                        pool[size_t(v.brickStart[sb]) + size_t(localOf[0][i] + localOf[1][j] * E + localOf[2][k] * E * E)];
+                        pool[size_t(v.brickStart[sb]) +
+                             size_t(localOf[0][i] + localOf[1][j] * E + localOf[2][k] * E * E)];
                 }
         int32_t* out = g.entries.data() + start[b];
         for (int k = 1; k <= E; ++k)

@@ -163,7 +163,8 @@ struct VolumeIntegrator {
     // `cell` of brick `brick`: the trilinear interpolation of the cell's eight central
     // differences, 9 gathers instead of six samples' 18 and their arithmetic.
     template <int W, class Scene>
-    static RTFACT_INLINE Vec3<W> gradientFromBricks(const Scene& s, const Vec3<W>& p, const Packet<W, int32_t> (&cell)[3],
+    static RTFACT_INLINE Vec3<W> gradientFromBricks(const Scene& s, const Vec3<W>& p,
+                                                    const Packet<W, int32_t> (&cell)[3],
                                                     const Packet<W, int32_t> (&brick)[3]) {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
@@ -411,8 +412,8 @@ struct VolumeIntegrator {
                         if (any(contrib)) {
                             Vec3<W> rgb(tr, tg, tb);
                             if constexpr (mode == VolumeMode::Shaded) {
-                                const Vec3<W> g = !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c)
-                                                                       : gradient<W, L>(s, p);
+                                const Vec3<W> g =
+                                    !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
                                 rgb = rgb * shadeFactor<W>(g, d);
                             }
                             const P w = (P(1.0f) - alpha) * a;
