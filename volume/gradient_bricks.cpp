@@ -8,26 +8,13 @@
 
 namespace rtfact::volume {
 
-GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<uint8_t>& brickShown,
-                                     uint64_t maxBytes) {
+namespace {
+template <class T>
+void fill(const BrickedVolume& v, const std::vector<uint8_t>& brickShown, GradientBricks& g) {
     using BV = BrickedVolume;
-    GradientBricks g;
-    const size_t nb = v.brickCount();
-    if (v.storage != Storage::U8 || brickShown.size() != nb) return g;
-    // brick 0 (zeros) and the shown ones
-    const uint64_t count =
-        uint64_t(1 + std::count_if(brickShown.begin(), brickShown.end(), [](uint8_t s) { return s; })) *
-        uint64_t(BV::kBrick);
-    if (count * 4 > maxBytes || count + 64 > uint64_t(std::numeric_limits<int32_t>::max())) return g;
-    std::vector<int32_t> start(nb, 0);
-    int32_t next = BV::kBrick;
-    for (size_t b = 0; b < nb; ++b)
-        if (brickShown[b]) start[b] = std::exchange(next, next + BV::kBrick);
-    // + 64: wide gathers may read past the last entry
-    g.entries.assign(size_t(count) + 64, 0);
-    const uint8_t* pool = v.pool.data();
+    const T* pool = v.data<T>();
     constexpr int E = BV::kEdge, C = BV::kCells, N = E + 2;  // N: the brick and one voxel around it
-    tbb::parallel_for(size_t(0), nb, [&](size_t b) {
+    tbb::parallel_for(size_t(0), v.brickCount(), [&](size_t b) {
         if (!brickShown[b]) return;
         const int bc[3] = {int(b % size_t(v.nb[0])), int(b / size_t(v.nb[0]) % size_t(v.nb[1])),
                            int(b / (size_t(v.nb[0]) * size_t(v.nb[1])))};
@@ -40,7 +27,7 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
                 brickOf[a][i] = std::min(x / C, v.nb[a] - 1);
                 localOf[a][i] = x - brickOf[a][i] * C;
             }
-        uint8_t around[N * N * N];
+        T around[N * N * N];
         for (int k = 0; k < N; ++k)
             for (int j = 0; j < N; ++j)
                 for (int i = 0; i < N; ++i) {
@@ -49,16 +36,42 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
                         pool[size_t(v.brickStart[sb]) +
                              size_t(localOf[0][i] + localOf[1][j] * E + localOf[2][k] * E * E)];
                 }
-        int32_t* out = g.entries.data() + start[b];
+        int32_t* out = g.entries.data() + g.start[b];
         for (int k = 1; k <= E; ++k)
             for (int j = 1; j <= E; ++j)
-                for (int i = 1; i <= E; ++i) {
+                for (int i = 1; i <= E; ++i, out += sizeof(T)) {
                     const int c = (k * N + j) * N + i;
-                    *out++ = pack(int(around[c + 1]) - int(around[c - 1]), int(around[c + N]) - int(around[c - N]),
-                                  int(around[c + N * N]) - int(around[c - N * N]));
+                    GradientBricks::pack<sizeof(T)>(int(around[c + 1]) - int(around[c - 1]),
+                                                    int(around[c + N]) - int(around[c - N]),
+                                                    int(around[c + N * N]) - int(around[c - N * N]), out);
                 }
     });
-    g.start = std::move(start);
+}
+}  // namespace
+
+GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<uint8_t>& brickShown,
+                                     uint64_t maxBytes) {
+    using BV = BrickedVolume;
+    GradientBricks g;
+    const size_t nb = v.brickCount();
+    if (v.storage == Storage::F32 || brickShown.size() != nb) return g;
+    const int words = storageBytes(v.storage);
+    // brick 0 (zeros) and the shown ones
+    const uint64_t bricks =
+        1 + uint64_t(std::count_if(brickShown.begin(), brickShown.end(), [](uint8_t s) { return s; }));
+    const uint64_t count = bricks * uint64_t(BV::kBrick * words);
+    if (count * 4 > maxBytes || count + 64 > uint64_t(std::numeric_limits<int32_t>::max())) return g;
+    g.start.assign(nb, 0);
+    int32_t next = BV::kBrick * words;
+    for (size_t b = 0; b < nb; ++b)
+        if (brickShown[b]) g.start[b] = std::exchange(next, next + BV::kBrick * words);
+    // + 64: wide gathers may read past the last entry
+    g.entries.assign(size_t(count) + 64, 0);
+    if (words == 1)
+        fill<uint8_t>(v, brickShown, g);
+    else
+        fill<uint16_t>(v, brickShown, g);
+    g.words = words;
     return g;
 }
 

@@ -92,18 +92,6 @@ struct VolumeIntegrator {
     static RTFACT_INLINE Vec3<G> group(const Vec3<N>& v, int k) {
         return {group<G>(v.x, k), group<G>(v.y, k), group<G>(v.z, k)};
     }
-    template <int W>
-    static RTFACT_INLINE Packet<W, int32_t> shiftRight(const Packet<W, int32_t>& a, int k) {
-        Packet<W, int32_t> r;
-        for (int i = 0; i < Packet<W, int32_t>::C; ++i) r.c[i] = a.c[i] >> k;
-        return r;
-    }
-    template <int W>
-    static RTFACT_INLINE Packet<W, int32_t> shiftLeft(const Packet<W, int32_t>& a, int k) {
-        Packet<W, int32_t> r;
-        for (int i = 0; i < Packet<W, int32_t>::C; ++i) r.c[i] = a.c[i] << k;
-        return r;
-    }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
     template <int W, VoxelLayout L = VoxelLayout::Rows, class Scene>
     static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p) {
@@ -111,8 +99,7 @@ struct VolumeIntegrator {
         static_assert(Scene::kCells == 8);
         const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
         const I start =
-            gather(s.template entryStart<L>(), shiftRight<W>(cell[0], 3) + shiftRight<W>(cell[1], 3) * I(s.nbx) +
-                                                   shiftRight<W>(cell[2], 3) * I(s.nbxy));
+            gather(s.template entryStart<L>(), (cell[0] >> 3) + (cell[1] >> 3) * I(s.nbx) + (cell[2] >> 3) * I(s.nbxy));
         return sampleCell<W, L>(s, p, cell, start);
     }
     // The same with the cell (toInt of p) and its brick's first entry (in layout L) known.
@@ -159,31 +146,35 @@ struct VolumeIntegrator {
         }
         return g;
     }
-    // The same from the gradient bricks (VolumeScene::gradients: non-empty), for p in cell
-    // `cell` of brick `brick`: the trilinear interpolation of the cell's eight central
-    // differences, 9 gathers instead of six samples' 18 and their arithmetic.
+    // The same from the gradient bricks (VolumeScene::gradients, built: u8 and u16), for p
+    // in cell `cell` of brick `brick`: the trilinear interpolation of the cell's eight
+    // central differences, 8 (u8) or 16 (u16) gathers and a brick lookup instead of six
+    // trilinear samples.
     template <int W, class Scene>
     static RTFACT_INLINE Vec3<W> gradientFromBricks(const Scene& s, const Vec3<W>& p,
                                                     const Packet<W, int32_t> (&cell)[3],
                                                     const Packet<W, int32_t> (&brick)[3]) {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
-        constexpr int E = Scene::kEdge, B = GradientBricks::kFieldBits;
+        constexpr int E = Scene::kEdge, B = int(sizeof(typename Scene::Voxel));
+        static_assert(B <= 2, "gradient bricks are u8 or u16");
         const I id = brick[0] + brick[1] * I(s.nbx) + brick[2] * I(s.nbxy);
-        const I base = gather(s.gradients.start.data(), id) + (cell[0] & I(7)) + (cell[1] & I(7)) * I(E) +
-                       (cell[2] & I(7)) * I(E * E);
+        const I base = gather(s.gradients.start.data(), id) +
+                       ((cell[0] & I(7)) + (cell[1] & I(7)) * I(E) + (cell[2] & I(7)) * I(E * E)) * I(B);
         const P fx = p.x - toFloat(cell[0]), fy = p.y - toFloat(cell[1]), fz = p.z - toFloat(cell[2]);
-        // corner (x, y, z) of the cell: entry base + x + E y + E^2 z
+        // corner (x, y, z) of the cell: entry x + E y + E^2 z from the cell's first
         Vec3<W> row[4];  // the x-lerps of rows (y, z) = (0, 0), (1, 0), (0, 1), (1, 1)
         for (int r = 0; r < 4; ++r) {
-            const int off = (r & 1) * E + (r >> 1) * E * E;
-            const I e0 = gather(s.gradients.entries.data(), base + I(off));
-            const I e1 = gather(s.gradients.entries.data(), base + I(off + 1));
+            const int off = ((r & 1) * E + (r >> 1) * E * E) * B;
+            I w0[B], w1[B], g0[3], g1[3];
+            for (int k = 0; k < B; ++k) {
+                w0[k] = gather(s.gradients.entries.data(), base + I(off + k));
+                w1[k] = gather(s.gradients.entries.data(), base + I(off + B + k));
+            }
+            GradientBricks::decode<B>(w0, g0);
+            GradientBricks::decode<B>(w1, g1);
             for (int a = 0; a < 3; ++a) {
-                // field a sign-extended: to the top bits, then an arithmetic shift down
-                const int up = 32 - B * (a + 1);
-                const P a0 = toFloat(shiftRight<W>(shiftLeft<W>(e0, up), 32 - B));
-                const P a1 = toFloat(shiftRight<W>(shiftLeft<W>(e1, up), 32 - B));
+                const P a0 = toFloat(g0[a]), a1 = toFloat(g1[a]);
                 row[r][a] = a0 + (a1 - a0) * fx;
             }
         }
@@ -334,8 +325,8 @@ struct VolumeIntegrator {
             // p < dims - 1 keeps them inside their grids)
             static_assert(Scene::kCells == 8 && Scene::kSub == 4);
             const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
-            const I c[3] = {shiftRight<W>(cell[0], 3), shiftRight<W>(cell[1], 3), shiftRight<W>(cell[2], 3)};
-            const I sc[3] = {shiftRight<W>(cell[0], 2), shiftRight<W>(cell[1], 2), shiftRight<W>(cell[2], 2)};
+            const I c[3] = {cell[0] >> 3, cell[1] >> 3, cell[2] >> 3};
+            const I sc[3] = {cell[0] >> 2, cell[1] >> 2, cell[2] >> 2};
             Mask<W> samp = alive;
             I start(0);
             bool haveStart = false;
@@ -363,7 +354,7 @@ struct VolumeIntegrator {
                     start = select(skipped, I(0), (info & I(Scene::kPoolMask)) * I(Scene::template kBrickStride<L>));
                     haveStart = true;
                     if (adaptive) {
-                        I l = shiftRight<W>(info, 28) & I(3);
+                        I l = (info >> 28) & I(3);
                         if (any(l > I(0))) {
                             // A long step stands for samples kf .. kf + m - 1, which must all
                             // lie in this brick (this sub-brick where the multiple is the
@@ -412,8 +403,12 @@ struct VolumeIntegrator {
                         if (any(contrib)) {
                             Vec3<W> rgb(tr, tg, tb);
                             if constexpr (mode == VolumeMode::Shaded) {
-                                const Vec3<W> g =
-                                    !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
+                                Vec3<W> g;
+                                if constexpr (sizeof(typename Scene::Voxel) <= 2)
+                                    g = !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c)
+                                                             : gradient<W, L>(s, p);
+                                else
+                                    g = gradient<W, L>(s, p);
                                 rgb = rgb * shadeFactor<W>(g, d);
                             }
                             const P w = (P(1.0f) - alpha) * a;

@@ -90,6 +90,17 @@ struct __attribute__((may_alias)) Packet {
         for (int i = 0; i < C; ++i) r.c[i] = -a.c[i];
         return r;
     }
+    // Shifts by k bits (arithmetic right shift for signed T).
+    friend RTFACT_INLINE Packet operator<<(const Packet& a, int k) requires std::is_integral_v<T> {
+        Packet r;
+        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] << k;
+        return r;
+    }
+    friend RTFACT_INLINE Packet operator>>(const Packet& a, int k) requires std::is_integral_v<T> {
+        Packet r;
+        for (int i = 0; i < C; ++i) r.c[i] = a.c[i] >> k;
+        return r;
+    }
     friend RTFACT_INLINE Packet operator&(const Packet& a, const Packet& b) requires std::is_integral_v<T> {
         Packet r;
         for (int i = 0; i < C; ++i) r.c[i] = a.c[i] & b.c[i];

@@ -40,7 +40,11 @@ void checkOps() {
         const Mask<N> lt = a<b, le = a <= b, gt = a> b, eq = a == a, ne = a != b;
         const Packet<N, int32_t> ai = toInt(a);
         const Packet<N> af = toFloat(ai);
+        const int k = int(rng() % 31);
+        const Packet<N, int32_t> shl = ai << k, sar = ai >> k;
         for (int i = 0; i < N; ++i) {
+            EXPECT_EQ(shl[i], int32_t(uint32_t(ai[i]) << k));
+            EXPECT_EQ(sar[i], ai[i] >> k);  // arithmetic: the sign is kept
             const float x = a[i], y = b[i], p = pos[i];
             EXPECT_EQ(sum[i], x + y);
             EXPECT_EQ(dif[i], x - y);

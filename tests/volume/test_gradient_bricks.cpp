@@ -1,9 +1,11 @@
-// Gradient bricks (volume/gradient_bricks.h): their entries are the clamped central
-// differences of the voxels (brute force over BrickedVolume::stored), the gradient read from
-// them equals the six-sample gradient at random positions (widths 1 and native, brick faces
-// and the grid's border included), and shaded images with and without them match.
+// Gradient bricks (volume/gradient_bricks.h), u8 and u16: their entries decode to the
+// clamped central differences of the voxels (brute force over BrickedVolume::stored), the
+// gradient read from them equals the six-sample gradient at random positions (widths 1 and
+// native, brick faces and the grid's border included), and shaded images with and without
+// them match.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "core/render/framebuffer.h"
@@ -23,42 +25,45 @@ namespace {
 
 constexpr int kW = simd::kNativeWidth;
 
-// Random u8 voxels, sizes no brick multiple, and a zero corner (bricks sharing brick 0).
+// Random voxels over the whole range, sizes no brick multiple, and a zero corner (bricks
+// sharing brick 0).
+template <class T>
 BrickedVolume randomVolume() {
     VolumeGrid g;
     g.dims[0] = 37;
     g.dims[1] = 26;
     g.dims[2] = 19;
-    g.allocate(Storage::U8);
+    g.allocate(sizeof(T) == 1 ? Storage::U8 : Storage::U16);
     std::mt19937 rng(3);
-    std::uniform_int_distribution<int> u(0, 255);
-    for (size_t n = 0; n < g.voxelCount(); ++n) g.data<uint8_t>()[n] = uint8_t(u(rng));
+    std::uniform_int_distribution<int> u(0, int(std::numeric_limits<T>::max()));
+    for (size_t n = 0; n < g.voxelCount(); ++n) g.data<T>()[n] = T(u(rng));
     for (int k = 0; k < 9; ++k)
         for (int j = 0; j < 9; ++j)
-            for (int i = 0; i < 17; ++i) g.data<uint8_t>()[g.index(i, j, k)] = 0;
+            for (int i = 0; i < 17; ++i) g.data<T>()[g.index(i, j, k)] = 0;
     return brickVolume(g);
 }
 
-VolumeScene<uint8_t> shadedScene(const BrickedVolume& bv, bool skipping = true) {
+template <class T>
+VolumeScene<T> shadedScene(const BrickedVolume& bv, bool skipping = true) {
     VolumeRenderSettings rs;
     rs.mode = VolumeMode::Shaded;
     rs.skipping = skipping;
     const auto [lo, hi] = bv.valueRange();
-    return VolumeScene<uint8_t>(bv, buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, rs.stepVoxels), rs);
+    return VolumeScene<T>(bv, buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, rs.stepVoxels), rs);
 }
 
-template <int W>
-Vec3<W> bothGradients(const VolumeScene<uint8_t>& s, const Vec3<W>& q, Vec3<W>& six) {
+template <int W, class T>
+Vec3<W> bothGradients(const VolumeScene<T>& s, const Vec3<W>& q, Vec3<W>& six) {
     using I = Packet<W, int32_t>;
     const Vec3<W> p = VolumeIntegrator::clampToGrid<W>(s, q);
     const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
-    const I brick[3] = {VolumeIntegrator::shiftRight<W>(cell[0], 3), VolumeIntegrator::shiftRight<W>(cell[1], 3),
-                        VolumeIntegrator::shiftRight<W>(cell[2], 3)};
+    const I brick[3] = {cell[0] >> 3, cell[1] >> 3, cell[2] >> 3};
     six = VolumeIntegrator::gradient<W>(s, p);
     return VolumeIntegrator::gradientFromBricks<W>(s, p, cell, brick);
 }
 
-std::vector<float> render(const VolumeScene<uint8_t>& scene, int n) {
+template <class T>
+std::vector<float> render(const VolumeScene<T>& scene, int n) {
     const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}), n, n);
     RGBAFramebuffer fb(n, n);
     RenderOptions ro;
@@ -69,26 +74,35 @@ std::vector<float> render(const VolumeScene<uint8_t>& scene, int n) {
 
 }  // namespace
 
-TEST(GradientBricks, PackedFieldsRoundTrip) {
-    for (int x : {-255, -1, 0, 1, 254, 255})
-        for (int y : {-255, -7, 0, 200})
-            for (int z : {-255, 0, 3, 255}) {
-                const int32_t e = GradientBricks::pack(x, y, z);
-                EXPECT_EQ(GradientBricks::unpack(e, 0), x);
-                EXPECT_EQ(GradientBricks::unpack(e, 1), y);
-                EXPECT_EQ(GradientBricks::unpack(e, 2), z);
+template <int B>
+void checkRoundTrip(int m) {
+    for (int x : {-m, -m + 1, -1, 0, 1, m - 1, m})
+        for (int y : {-m, -7, 0, 200, m})
+            for (int z : {-m, 0, 3, m - 2, m}) {
+                int32_t w[B], g[3];
+                GradientBricks::pack<B>(x, y, z, w);
+                GradientBricks::decode<B>(w, g);
+                EXPECT_EQ(g[0], x);
+                EXPECT_EQ(g[1], y);
+                EXPECT_EQ(g[2], z);
             }
 }
+TEST(GradientBricks, PackedFieldsRoundTrip) {
+    checkRoundTrip<1>(255);
+    checkRoundTrip<2>(65535);
+}
 
-TEST(GradientBricks, EntriesAreClampedCentralDifferences) {
-    const BrickedVolume bv = randomVolume();
+template <class T>
+void checkEntries() {
+    constexpr int B = int(sizeof(T));
+    const BrickedVolume bv = randomVolume<T>();
     const size_t nb = bv.brickCount();
     std::vector<uint8_t> shown(nb, 0);
     for (size_t b = 0; b < nb; b += 2) shown[b] = 1;  // every other brick
     const GradientBricks g = GradientBricks::build(bv, shown, uint64_t(1) << 30);
-    ASSERT_FALSE(g.empty());
+    ASSERT_EQ(g.words, B);
     ASSERT_EQ(g.start.size(), nb);
-    for (int e = 0; e < BrickedVolume::kBrick; ++e) ASSERT_EQ(g.entries[size_t(e)], 0) << "brick 0 is zeros";
+    for (int e = 0; e < BrickedVolume::kBrick * B; ++e) ASSERT_EQ(g.entries[size_t(e)], 0) << "brick 0 is zeros";
     constexpr int C = BrickedVolume::kCells, E = BrickedVolume::kEdge;
     auto at = [&](int x, int y, int z) {
         return int(bv.stored(std::clamp(x, 0, bv.dims[0] - 1), std::clamp(y, 0, bv.dims[1] - 1),
@@ -109,25 +123,36 @@ TEST(GradientBricks, EntriesAreClampedCentralDifferences) {
                         for (int i = 0; i < E; ++i) {
                             const int x = bx * C + i, y = by * C + j, z = bz * C + k;
                             if (x >= bv.dims[0] || y >= bv.dims[1] || z >= bv.dims[2]) continue;  // never read
-                            const int32_t e = g.entries[size_t(g.start[b] + i + j * E + k * E * E)];
-                            ASSERT_EQ(GradientBricks::unpack(e, 0), at(x + 1, y, z) - at(x - 1, y, z)) << x << y << z;
-                            ASSERT_EQ(GradientBricks::unpack(e, 1), at(x, y + 1, z) - at(x, y - 1, z)) << x << y << z;
-                            ASSERT_EQ(GradientBricks::unpack(e, 2), at(x, y, z + 1) - at(x, y, z - 1)) << x << y << z;
+                            int32_t w[B], d[3];
+                            for (int q = 0; q < B; ++q)
+                                w[q] = g.entries[size_t(g.start[b] + (i + j * E + k * E * E) * B + q)];
+                            GradientBricks::decode<B>(w, d);
+                            ASSERT_EQ(d[0], at(x + 1, y, z) - at(x - 1, y, z)) << x << "," << y << "," << z;
+                            ASSERT_EQ(d[1], at(x, y + 1, z) - at(x, y - 1, z)) << x << "," << y << "," << z;
+                            ASSERT_EQ(d[2], at(x, y, z + 1) - at(x, y, z - 1)) << x << "," << y << "," << z;
                             ++checked;
                         }
             }
     EXPECT_GT(checked, bv.voxelCount() / 3);
-    // over budget, or not u8: none (the march takes six samples)
-    EXPECT_TRUE(GradientBricks::build(bv, shown, 1000).empty());
-    const BrickedVolume u16 = brickVolume(makeSheppLogan(20, Storage::U16));
-    EXPECT_TRUE(GradientBricks::build(u16, std::vector<uint8_t>(u16.brickCount(), 1), uint64_t(1) << 30).empty());
+    EXPECT_TRUE(GradientBricks::build(bv, shown, 1000).empty()) << "over budget: none (six samples)";
+}
+TEST(GradientBricks, EntriesAreClampedCentralDifferencesU8) { checkEntries<uint8_t>(); }
+TEST(GradientBricks, EntriesAreClampedCentralDifferencesU16) { checkEntries<uint16_t>(); }
+TEST(GradientBricks, NoneForF32) {
+    VolumeGrid grid;
+    grid.dims[0] = grid.dims[1] = grid.dims[2] = 12;
+    grid.allocate(Storage::F32);
+    for (size_t n = 0; n < grid.voxelCount(); ++n) grid.data<float>()[n] = float(n % 7);
+    const BrickedVolume f = brickVolume(grid);
+    ASSERT_EQ(f.storage, Storage::F32);
+    EXPECT_TRUE(GradientBricks::build(f, std::vector<uint8_t>(f.brickCount(), 1), uint64_t(1) << 30).empty());
 }
 
-template <int W>
+template <int W, class T>
 void checkEqualsSixSamples() {
-    const BrickedVolume bv = randomVolume();
-    VolumeScene<uint8_t> s = shadedScene(bv);
-    ASSERT_FALSE(s.gradients.empty()) << "a shaded u8 scene has gradient bricks";
+    const BrickedVolume bv = randomVolume<T>();
+    VolumeScene<T> s = shadedScene<T>(bv);
+    ASSERT_FALSE(s.gradients.empty()) << "a shaded u8/u16 scene has gradient bricks";
     s.gradients = GradientBricks::build(bv, std::vector<uint8_t>(bv.brickCount(), 1), uint64_t(1) << 30);
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -141,23 +166,30 @@ void checkEqualsSixSamples() {
             q.setLane(i, v);
         }
         Vec3<W> six;
-        const Vec3<W> fast = bothGradients<W>(s, q, six);
+        const Vec3<W> fast = bothGradients<W, T>(s, q, six);
         for (int i = 0; i < W; ++i)
             for (int a = 0; a < 3; ++a)
-                ASSERT_NEAR(fast[a][i], six[a][i], 2e-3f)
+                ASSERT_NEAR(fast[a][i], six[a][i], 1e-5f * float(std::numeric_limits<T>::max()))
                     << "lane " << i << " axis " << a << " at " << q.x[i] << "," << q.y[i] << "," << q.z[i];
     }
 }
 
-TEST(GradientBricks, EqualSixSampleGradientWidth1) { checkEqualsSixSamples<1>(); }
-TEST(GradientBricks, EqualSixSampleGradientNative) { checkEqualsSixSamples<kW>(); }
+TEST(GradientBricks, EqualSixSampleGradientWidth1) {
+    checkEqualsSixSamples<1, uint8_t>();
+    checkEqualsSixSamples<1, uint16_t>();
+}
+TEST(GradientBricks, EqualSixSampleGradientNative) {
+    checkEqualsSixSamples<kW, uint8_t>();
+    checkEqualsSixSamples<kW, uint16_t>();
+}
 
 // The shaded march reads the gradient bricks where the TF shows the volume (skipping on
 // or off): the image is the six-sample one's within float rounding.
-TEST(GradientBricks, ShadedImageMatchesSixSamples) {
-    const BrickedVolume bv = brickVolume(makeSheppLogan(45, Storage::U8));
+template <class T>
+void checkShadedImage(Storage st) {
+    const BrickedVolume bv = brickVolume(makeSheppLogan(45, st));
     for (bool skipping : {true, false}) {
-        VolumeScene<uint8_t> s = shadedScene(bv, skipping);
+        VolumeScene<T> s = shadedScene<T>(bv, skipping);
         ASSERT_FALSE(s.gradients.empty());
         const std::vector<float> fast = render(s, 64);
         s.gradients = {};
@@ -171,9 +203,11 @@ TEST(GradientBricks, ShadedImageMatchesSixSamples) {
         EXPECT_LT(maxDiff, 1e-4f) << "skipping " << skipping;
         EXPECT_GT(sum, 0.0f);
     }
-    // other modes and storage types build none
+    // other modes build none
     VolumeRenderSettings dvr;
     const auto [lo, hi] = bv.valueRange();
     const TFTable table = buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, dvr.stepVoxels);
-    EXPECT_TRUE(VolumeScene<uint8_t>(bv, table, dvr).gradients.empty());
+    EXPECT_TRUE(VolumeScene<T>(bv, table, dvr).gradients.empty());
 }
+TEST(GradientBricks, ShadedImageMatchesSixSamplesU8) { checkShadedImage<uint8_t>(Storage::U8); }
+TEST(GradientBricks, ShadedImageMatchesSixSamplesU16) { checkShadedImage<uint16_t>(Storage::U16); }
