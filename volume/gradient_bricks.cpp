@@ -6,6 +6,8 @@
 #include <limits>
 #include <utility>
 
+#include "core/util/huge_pages.h"
+
 namespace rtfact::volume {
 
 namespace {
@@ -29,13 +31,12 @@ void fill(const BrickedVolume& v, const std::vector<uint8_t>& brickShown, Gradie
             }
         T around[N * N * N];
         for (int k = 0; k < N; ++k)
-            for (int j = 0; j < N; ++j)
-                for (int i = 0; i < N; ++i) {
-                    const size_t sb = v.brickIndex(brickOf[0][i], brickOf[1][j], brickOf[2][k]);
-                    around[(k * N + j) * N + i] =
-                        pool[size_t(v.brickStart[sb]) +
-                             size_t(localOf[0][i] + localOf[1][j] * E + localOf[2][k] * E * E)];
-                }
+            for (int j = 0; j < N; ++j) {
+                const int32_t* rowStart = v.brickStart.data() + v.brickIndex(0, brickOf[1][j], brickOf[2][k]);
+                const int yz = localOf[1][j] * E + localOf[2][k] * E * E;
+                T* dst = around + (k * N + j) * N;
+                for (int i = 0; i < N; ++i) dst[i] = pool[rowStart[brickOf[0][i]] + localOf[0][i] + yz];
+            }
         int32_t* out = g.entries.data() + g.start[b];
         for (int k = 1; k <= E; ++k)
             for (int j = 1; j <= E; ++j)
@@ -65,8 +66,9 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
     int32_t next = BV::kBrick * words;
     for (size_t b = 0; b < nb; ++b)
         if (brickShown[b]) g.start[b] = std::exchange(next, next + BV::kBrick * words);
-    // + 64: wide gathers may read past the last entry
-    g.entries.assign(size_t(count) + 64, 0);
+    // + 64: wide gathers may read past the last entry; on huge pages (4 KiB page faults
+    // took most of the build)
+    resizeHugePages(g.entries, size_t(count) + 64);
     if (words == 1)
         fill<uint8_t>(v, brickShown, g);
     else
