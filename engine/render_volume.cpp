@@ -35,8 +35,10 @@ float defaultIso(float lo, float hi) { return lo <= -500.0f ? 300.0f : lo + 0.4f
 
 template <class T>
 std::unique_ptr<Renderable> make(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& rs,
-                                 const TransferFunction& tf, std::pair<float, float> window) {
+                                 const TransferFunction& tf, std::pair<float, float> window, Stats& stats) {
     auto scene = std::make_shared<VolumeScene<T>>(v, table, rs);
+    // shaded: the gradient bricks' memory (0: six samples a gradient)
+    if (rs.mode == VolumeMode::Shaded) stats.add("gradient_mb", double(scene->gradients.memoryBytes()) / 1048576.0);
     auto r = std::make_unique<RenderableOf<VolumeScene<T>, VolumeIntegrator>>(scene, VolumeIntegrator{});
     r->stats = [name = tf.name, window](Stats& st, const RenderStats& rst) {
         const uint64_t samples = rst.counters.volumeSamples, skipped = rst.counters.volumeSkipped;
@@ -97,13 +99,13 @@ std::unique_ptr<Renderable> makeVolumeRenderable(SceneData& d, const VolumeSetti
     std::unique_ptr<Renderable> r;
     switch (vol.storage) {
         case Storage::U8:
-            r = make<uint8_t>(vol, table, rs, tf, window);
+            r = make<uint8_t>(vol, table, rs, tf, window, stats);
             break;
         case Storage::U16:
-            r = make<uint16_t>(vol, table, rs, tf, window);
+            r = make<uint16_t>(vol, table, rs, tf, window, stats);
             break;
         default:
-            r = make<float>(vol, table, rs, tf, window);
+            r = make<float>(vol, table, rs, tf, window, stats);
             break;
     }
     stats.add("build_ms", msSince(t0));
