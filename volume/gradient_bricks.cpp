@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <type_traits>
 #include <utility>
 
 #include "core/util/huge_pages.h"
@@ -37,14 +38,19 @@ void fill(const BrickedVolume& v, const std::vector<uint8_t>& brickShown, Gradie
                 T* dst = around + (k * N + j) * N;
                 for (int i = 0; i < N; ++i) dst[i] = pool[rowStart[brickOf[0][i]] + localOf[0][i] + yz];
             }
-        int32_t* out = g.entries.data() + g.start[b];
-        for (int k = 1; k <= E; ++k)
+        for (int k = 1, e = g.start[b]; k <= E; ++k)
             for (int j = 1; j <= E; ++j)
-                for (int i = 1; i <= E; ++i, out += sizeof(T)) {
+                for (int i = 1; i <= E; ++i, e += g.words) {
                     const int c = (k * N + j) * N + i;
-                    GradientBricks::pack<sizeof(T)>(int(around[c + 1]) - int(around[c - 1]),
-                                                    int(around[c + N]) - int(around[c - N]),
-                                                    int(around[c + N * N]) - int(around[c - N * N]), out);
+                    if constexpr (std::is_same_v<T, float>) {
+                        g.values[size_t(e)] = around[c + 1] - around[c - 1];
+                        g.values[size_t(e) + 1] = around[c + N] - around[c - N];
+                        g.values[size_t(e) + 2] = around[c + N * N] - around[c - N * N];
+                    } else {
+                        GradientBricks::pack<sizeof(T)>(
+                            int(around[c + 1]) - int(around[c - 1]), int(around[c + N]) - int(around[c - N]),
+                            int(around[c + N * N]) - int(around[c - N * N]), g.entries.data() + e);
+                    }
                 }
     });
 }
@@ -55,8 +61,8 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
     using BV = BrickedVolume;
     GradientBricks g;
     const size_t nb = v.brickCount();
-    if (v.storage == Storage::F32 || brickShown.size() != nb) return g;
-    const int words = storageBytes(v.storage);
+    if (brickShown.size() != nb) return g;
+    const int words = v.storage == Storage::F32 ? 3 : storageBytes(v.storage);
     // brick 0 (zeros) and the shown ones
     const uint64_t bricks =
         1 + uint64_t(std::count_if(brickShown.begin(), brickShown.end(), [](uint8_t s) { return s; }));
@@ -68,12 +74,17 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
         if (brickShown[b]) g.start[b] = std::exchange(next, next + BV::kBrick * words);
     // + 64: wide gathers may read past the last entry; on huge pages (4 KiB page faults
     // took most of the build)
-    resizeHugePages(g.entries, size_t(count) + 64);
-    if (words == 1)
-        fill<uint8_t>(v, brickShown, g);
-    else
-        fill<uint16_t>(v, brickShown, g);
     g.words = words;
+    if (words == 3) {
+        resizeHugePages(g.values, size_t(count) + 64);
+        fill<float>(v, brickShown, g);
+    } else {
+        resizeHugePages(g.entries, size_t(count) + 64);
+        if (words == 1)
+            fill<uint8_t>(v, brickShown, g);
+        else
+            fill<uint16_t>(v, brickShown, g);
+    }
     return g;
 }
 

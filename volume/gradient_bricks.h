@@ -1,13 +1,13 @@
-// GradientBricks: per brick of a u8 or u16 volume, the central differences of its 9^3
-// samples, (v[i+1] - v[i-1]) per axis with the neighbours clamped into the grid, packed
-// exactly: u8 differences (in [-255, 255]) as three 10-bit fields of one 32-bit word, u16
-// ones (in [-65535, 65535]) in two words. Shaded DVR reads a sample's gradient from its
-// cell's eight entries: the central difference of the trilinear field one voxel either
-// side along an axis equals the trilinear interpolation of the voxels' differences, at the
-// volume's border too (clamped the same way), so the shading is the six-sample gradient's
-// with 8 (u8) or 16 (u16) 32-bit loads instead of six trilinear samples. Only bricks the
-// transfer function shows are stored; the others share brick 0 (zeros: no sample there
-// contributes, so none is shaded).
+// GradientBricks: per brick of a volume, the central differences of its 9^3 samples,
+// (v[i+1] - v[i-1]) per axis with the neighbours clamped into the grid, packed exactly for
+// integer voxels: u8 differences (in [-255, 255]) as three 10-bit fields of one 32-bit
+// word, u16 ones (in [-65535, 65535]) in two words; f32 ones as three floats. Shaded DVR
+// reads a sample's gradient from its cell's eight entries: the central difference of the
+// trilinear field one voxel either side along an axis equals the trilinear interpolation
+// of the voxels' differences, at the volume's border too (clamped the same way), so the
+// shading is the six-sample gradient's (to float rounding) with 8, 16 or 24 32-bit loads
+// instead of six trilinear samples. Only bricks the transfer function shows are stored;
+// the others share brick 0 (zeros: no sample there contributes, so none is shaded).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -17,12 +17,13 @@
 namespace rtfact::volume {
 
 struct GradientBricks {
-    int words = 0;                 // 32-bit words an entry: 1 (u8), 2 (u16); 0: none built
-    std::vector<int32_t> entries;  // kBrick entries per stored brick, brick 0 all zero
+    int words = 0;                 // 32-bit words an entry: 1 (u8), 2 (u16), 3 (f32); 0: none built
+    std::vector<int32_t> entries;  // u8, u16: kBrick entries per stored brick, brick 0 all zero
+    std::vector<float> values;     // f32: the same as (x, y, z) floats
     std::vector<int32_t> start;    // per brick of the grid: its first word (0: not stored)
 
     bool empty() const { return words == 0; }
-    size_t memoryBytes() const { return (entries.capacity() + start.capacity()) * 4; }
+    size_t memoryBytes() const { return (entries.capacity() + values.capacity() + start.capacity()) * 4; }
 
     // An entry of voxels of Bytes bytes (1: u8, 2: u16) from its differences.
     template <int Bytes>
@@ -48,9 +49,8 @@ struct GradientBricks {
         }
     }
 
-    // For a u8 or u16 volume: the bricks with brickShown[b] != 0. Empty (the caller falls
-    // back to six samples a gradient) for f32 volumes and when the entries would exceed
-    // maxBytes or 32-bit offsets.
+    // The bricks with brickShown[b] != 0. Empty (the caller falls back to six samples a
+    // gradient) when the entries would exceed maxBytes or 32-bit offsets.
     static GradientBricks build(const BrickedVolume& v, const std::vector<uint8_t>& brickShown, uint64_t maxBytes);
 };
 

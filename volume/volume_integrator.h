@@ -5,6 +5,7 @@
 // same sample positions they would have reached by stepping (skipping changes nothing),
 // and lanes drop out when they leave the box or become opaque.
 #pragma once
+#include <type_traits>
 #include <utility>
 
 #include "core/concepts/integrator.h"
@@ -156,8 +157,8 @@ struct VolumeIntegrator {
                                                     const Packet<W, int32_t> (&brick)[3]) {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
-        constexpr int E = Scene::kEdge, B = int(sizeof(typename Scene::Voxel));
-        static_assert(B <= 2, "gradient bricks are u8 or u16");
+        using V = typename Scene::Voxel;
+        constexpr int E = Scene::kEdge, B = std::is_same_v<V, float> ? 3 : int(sizeof(V));  // words an entry
         const I id = brick[0] + brick[1] * I(s.nbx) + brick[2] * I(s.nbxy);
         const I base = gather(s.gradients.start.data(), id) +
                        ((cell[0] & I(7)) + (cell[1] & I(7)) * I(E) + (cell[2] & I(7)) * I(E * E)) * I(B);
@@ -166,17 +167,23 @@ struct VolumeIntegrator {
         Vec3<W> row[4];  // the x-lerps of rows (y, z) = (0, 0), (1, 0), (0, 1), (1, 1)
         for (int r = 0; r < 4; ++r) {
             const int off = ((r & 1) * E + (r >> 1) * E * E) * B;
-            I w0[B], w1[B], g0[3], g1[3];
-            for (int k = 0; k < B; ++k) {
-                w0[k] = gather(s.gradients.entries.data(), base + I(off + k));
-                w1[k] = gather(s.gradients.entries.data(), base + I(off + B + k));
+            P g0[3], g1[3];
+            if constexpr (B == 3) {
+                for (int a = 0; a < 3; ++a) {
+                    g0[a] = gather(s.gradients.values.data(), base + I(off + a));
+                    g1[a] = gather(s.gradients.values.data(), base + I(off + B + a));
+                }
+            } else {
+                I w0[B], w1[B], d0[3], d1[3];
+                for (int k = 0; k < B; ++k) {
+                    w0[k] = gather(s.gradients.entries.data(), base + I(off + k));
+                    w1[k] = gather(s.gradients.entries.data(), base + I(off + B + k));
+                }
+                GradientBricks::decode<B>(w0, d0);
+                GradientBricks::decode<B>(w1, d1);
+                for (int a = 0; a < 3; ++a) g0[a] = toFloat(d0[a]), g1[a] = toFloat(d1[a]);
             }
-            GradientBricks::decode<B>(w0, g0);
-            GradientBricks::decode<B>(w1, g1);
-            for (int a = 0; a < 3; ++a) {
-                const P a0 = toFloat(g0[a]), a1 = toFloat(g1[a]);
-                row[r][a] = a0 + (a1 - a0) * fx;
-            }
+            for (int a = 0; a < 3; ++a) row[r][a] = g0[a] + (g1[a] - g0[a]) * fx;
         }
         Vec3<W> g;
         for (int a = 0; a < 3; ++a) {
@@ -403,12 +410,8 @@ struct VolumeIntegrator {
                         if (any(contrib)) {
                             Vec3<W> rgb(tr, tg, tb);
                             if constexpr (mode == VolumeMode::Shaded) {
-                                Vec3<W> g;
-                                if constexpr (sizeof(typename Scene::Voxel) <= 2)
-                                    g = !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c)
-                                                             : gradient<W, L>(s, p);
-                                else
-                                    g = gradient<W, L>(s, p);
+                                const Vec3<W> g =
+                                    !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
                                 rgb = rgb * shadeFactor<W>(g, d);
                             }
                             const P w = (P(1.0f) - alpha) * a;

@@ -104,7 +104,7 @@ struct VolumeScene {
     // is larger than the last-level caches, where it waits on memory at every new brick.
     static constexpr size_t kPrefetchPoolBytes = size_t(64) << 20;
     bool prefetchBricks = false;
-    // Shaded u8 and u16 volumes: the voxels' central differences, per brick the TF shows (empty
+    // Shaded: the voxels' central differences, per brick the TF shows (empty
     // otherwise, or beyond kMaxGradientBytes and a quarter of the available memory: the
     // march then takes six trilinear samples a gradient).
     static constexpr uint64_t kMaxGradientBytes = uint64_t(1) << 30;
@@ -165,7 +165,7 @@ struct VolumeScene {
             visible[i] = on ? 1 : 0;
             subFlags[i] = (on || !s.skipping) ? 1 : 0;
         }
-        if (s.mode == VolumeMode::Shaded && sizeof(T) <= 2) {
+        if (s.mode == VolumeMode::Shaded) {
             std::vector<uint8_t> shown(nc, 0);
             for (size_t i = 0; i < ns; ++i)
                 if (visible[i]) shown[brickOctant(i).first] = 1;

@@ -1,4 +1,4 @@
-// Gradient bricks (volume/gradient_bricks.h), u8 and u16: their entries decode to the
+// Gradient bricks (volume/gradient_bricks.h), u8, u16 and f32: their entries decode to the
 // clamped central differences of the voxels (brute force over BrickedVolume::stored), the
 // gradient read from them equals the six-sample gradient at random positions (widths 1 and
 // native, brick faces and the grid's border included), and shaded images with and without
@@ -7,6 +7,7 @@
 
 #include <limits>
 #include <random>
+#include <type_traits>
 
 #include "core/render/framebuffer.h"
 #include "core/render/pinhole_camera.h"
@@ -25,6 +26,16 @@ namespace {
 
 constexpr int kW = simd::kNativeWidth;
 
+template <class T>
+constexpr Storage storageOf() {
+    return std::is_same_v<T, float> ? Storage::F32 : sizeof(T) == 1 ? Storage::U8 : Storage::U16;
+}
+// the largest random integer of the volumes (f32: times 0.37)
+template <class T>
+constexpr float maxOf() {
+    return std::is_same_v<T, float> ? 2700.0f : float(std::numeric_limits<T>::max());
+}
+
 // Random voxels over the whole range, sizes no brick multiple, and a zero corner (bricks
 // sharing brick 0).
 template <class T>
@@ -33,10 +44,10 @@ BrickedVolume randomVolume() {
     g.dims[0] = 37;
     g.dims[1] = 26;
     g.dims[2] = 19;
-    g.allocate(sizeof(T) == 1 ? Storage::U8 : Storage::U16);
+    g.allocate(storageOf<T>());
     std::mt19937 rng(3);
-    std::uniform_int_distribution<int> u(0, int(std::numeric_limits<T>::max()));
-    for (size_t n = 0; n < g.voxelCount(); ++n) g.data<T>()[n] = T(u(rng));
+    std::uniform_int_distribution<int> u(0, int(maxOf<T>()));
+    for (size_t n = 0; n < g.voxelCount(); ++n) g.data<T>()[n] = T(u(rng)) * T(std::is_same_v<T, float> ? 0.37f : 1);
     for (int k = 0; k < 9; ++k)
         for (int j = 0; j < 9; ++j)
             for (int i = 0; i < 17; ++i) g.data<T>()[g.index(i, j, k)] = 0;
@@ -94,7 +105,7 @@ TEST(GradientBricks, PackedFieldsRoundTrip) {
 
 template <class T>
 void checkEntries() {
-    constexpr int B = int(sizeof(T));
+    constexpr int B = std::is_same_v<T, float> ? 3 : int(sizeof(T));
     const BrickedVolume bv = randomVolume<T>();
     const size_t nb = bv.brickCount();
     std::vector<uint8_t> shown(nb, 0);
@@ -102,11 +113,12 @@ void checkEntries() {
     const GradientBricks g = GradientBricks::build(bv, shown, uint64_t(1) << 30);
     ASSERT_EQ(g.words, B);
     ASSERT_EQ(g.start.size(), nb);
-    for (int e = 0; e < BrickedVolume::kBrick * B; ++e) ASSERT_EQ(g.entries[size_t(e)], 0) << "brick 0 is zeros";
+    for (int e = 0; e < BrickedVolume::kBrick * B; ++e)
+        ASSERT_EQ(B == 3 ? g.values[size_t(e)] : float(g.entries[size_t(e)]), 0.0f) << "brick 0 is zeros";
     constexpr int C = BrickedVolume::kCells, E = BrickedVolume::kEdge;
     auto at = [&](int x, int y, int z) {
-        return int(bv.stored(std::clamp(x, 0, bv.dims[0] - 1), std::clamp(y, 0, bv.dims[1] - 1),
-                             std::clamp(z, 0, bv.dims[2] - 1)));
+        return bv.stored(std::clamp(x, 0, bv.dims[0] - 1), std::clamp(y, 0, bv.dims[1] - 1),
+                         std::clamp(z, 0, bv.dims[2] - 1));
     };
     size_t checked = 0;
     for (int bz = 0; bz < bv.nb[2]; ++bz)
@@ -123,10 +135,16 @@ void checkEntries() {
                         for (int i = 0; i < E; ++i) {
                             const int x = bx * C + i, y = by * C + j, z = bz * C + k;
                             if (x >= bv.dims[0] || y >= bv.dims[1] || z >= bv.dims[2]) continue;  // never read
-                            int32_t w[B], d[3];
-                            for (int q = 0; q < B; ++q)
-                                w[q] = g.entries[size_t(g.start[b] + (i + j * E + k * E * E) * B + q)];
-                            GradientBricks::decode<B>(w, d);
+                            const int first = g.start[b] + (i + j * E + k * E * E) * B;
+                            float d[3];
+                            if constexpr (B == 3) {
+                                for (int a = 0; a < 3; ++a) d[a] = g.values[size_t(first + a)];
+                            } else {
+                                int32_t w[B], di[3];
+                                for (int q = 0; q < B; ++q) w[q] = g.entries[size_t(first + q)];
+                                GradientBricks::decode<B>(w, di);
+                                for (int a = 0; a < 3; ++a) d[a] = float(di[a]);
+                            }
                             ASSERT_EQ(d[0], at(x + 1, y, z) - at(x - 1, y, z)) << x << "," << y << "," << z;
                             ASSERT_EQ(d[1], at(x, y + 1, z) - at(x, y - 1, z)) << x << "," << y << "," << z;
                             ASSERT_EQ(d[2], at(x, y, z + 1) - at(x, y, z - 1)) << x << "," << y << "," << z;
@@ -138,21 +156,13 @@ void checkEntries() {
 }
 TEST(GradientBricks, EntriesAreClampedCentralDifferencesU8) { checkEntries<uint8_t>(); }
 TEST(GradientBricks, EntriesAreClampedCentralDifferencesU16) { checkEntries<uint16_t>(); }
-TEST(GradientBricks, NoneForF32) {
-    VolumeGrid grid;
-    grid.dims[0] = grid.dims[1] = grid.dims[2] = 12;
-    grid.allocate(Storage::F32);
-    for (size_t n = 0; n < grid.voxelCount(); ++n) grid.data<float>()[n] = float(n % 7);
-    const BrickedVolume f = brickVolume(grid);
-    ASSERT_EQ(f.storage, Storage::F32);
-    EXPECT_TRUE(GradientBricks::build(f, std::vector<uint8_t>(f.brickCount(), 1), uint64_t(1) << 30).empty());
-}
+TEST(GradientBricks, EntriesAreClampedCentralDifferencesF32) { checkEntries<float>(); }
 
 template <int W, class T>
 void checkEqualsSixSamples() {
     const BrickedVolume bv = randomVolume<T>();
     VolumeScene<T> s = shadedScene<T>(bv);
-    ASSERT_FALSE(s.gradients.empty()) << "a shaded u8/u16 scene has gradient bricks";
+    ASSERT_FALSE(s.gradients.empty()) << "a shaded scene has gradient bricks";
     s.gradients = GradientBricks::build(bv, std::vector<uint8_t>(bv.brickCount(), 1), uint64_t(1) << 30);
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -169,7 +179,7 @@ void checkEqualsSixSamples() {
         const Vec3<W> fast = bothGradients<W, T>(s, q, six);
         for (int i = 0; i < W; ++i)
             for (int a = 0; a < 3; ++a)
-                ASSERT_NEAR(fast[a][i], six[a][i], 1e-5f * float(std::numeric_limits<T>::max()))
+                ASSERT_NEAR(fast[a][i], six[a][i], 1e-5f * maxOf<T>())
                     << "lane " << i << " axis " << a << " at " << q.x[i] << "," << q.y[i] << "," << q.z[i];
     }
 }
@@ -177,17 +187,28 @@ void checkEqualsSixSamples() {
 TEST(GradientBricks, EqualSixSampleGradientWidth1) {
     checkEqualsSixSamples<1, uint8_t>();
     checkEqualsSixSamples<1, uint16_t>();
+    checkEqualsSixSamples<1, float>();
 }
 TEST(GradientBricks, EqualSixSampleGradientNative) {
     checkEqualsSixSamples<kW, uint8_t>();
     checkEqualsSixSamples<kW, uint16_t>();
+    checkEqualsSixSamples<kW, float>();
 }
 
 // The shaded march reads the gradient bricks where the TF shows the volume (skipping on
 // or off): the image is the six-sample one's within float rounding.
 template <class T>
-void checkShadedImage(Storage st) {
-    const BrickedVolume bv = brickVolume(makeSheppLogan(45, st));
+void checkShadedImage() {
+    VolumeGrid grid = makeSheppLogan(45, std::is_same_v<T, uint8_t> ? Storage::U8 : Storage::U16);
+    if constexpr (std::is_same_v<T, float>) {
+        VolumeGrid f;
+        for (int a = 0; a < 3; ++a) f.dims[a] = grid.dims[a];
+        f.allocate(Storage::F32);
+        for (size_t n = 0; n < grid.voxelCount(); ++n) f.data<float>()[n] = 0.25f * float(grid.data<uint16_t>()[n]);
+        grid = std::move(f);
+    }
+    const BrickedVolume bv = brickVolume(grid);
+    ASSERT_EQ(bv.storage, storageOf<T>());
     for (bool skipping : {true, false}) {
         VolumeScene<T> s = shadedScene<T>(bv, skipping);
         ASSERT_FALSE(s.gradients.empty());
@@ -209,5 +230,6 @@ void checkShadedImage(Storage st) {
     const TFTable table = buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, dvr.stepVoxels);
     EXPECT_TRUE(VolumeScene<T>(bv, table, dvr).gradients.empty());
 }
-TEST(GradientBricks, ShadedImageMatchesSixSamplesU8) { checkShadedImage<uint8_t>(Storage::U8); }
-TEST(GradientBricks, ShadedImageMatchesSixSamplesU16) { checkShadedImage<uint16_t>(Storage::U16); }
+TEST(GradientBricks, ShadedImageMatchesSixSamplesU8) { checkShadedImage<uint8_t>(); }
+TEST(GradientBricks, ShadedImageMatchesSixSamplesU16) { checkShadedImage<uint16_t>(); }
+TEST(GradientBricks, ShadedImageMatchesSixSamplesF32) { checkShadedImage<float>(); }
