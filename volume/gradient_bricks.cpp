@@ -72,9 +72,9 @@ GradientBricks GradientBricks::build(const BrickedVolume& v, const std::vector<u
     int32_t next = BV::kBrick * words;
     for (size_t b = 0; b < nb; ++b)
         if (brickShown[b]) g.start[b] = std::exchange(next, next + BV::kBrick * words);
+    g.words = words;
     // + 64: wide gathers may read past the last entry; on huge pages (4 KiB page faults
     // took most of the build)
-    g.words = words;
     if (words == 3) {
         resizeHugePages(g.values, size_t(count) + 64);
         fill<float>(v, brickShown, g);

@@ -147,9 +147,9 @@ struct VolumeIntegrator {
         }
         return g;
     }
-    // The same from the gradient bricks (VolumeScene::gradients, built: u8 and u16), for p
-    // in cell `cell` of brick `brick`: the trilinear interpolation of the cell's eight
-    // central differences, 8 (u8) or 16 (u16) gathers and a brick lookup instead of six
+    // The same from the gradient bricks (VolumeScene::gradients, when built), for p in cell
+    // `cell` of brick `brick`: the trilinear interpolation of the cell's eight central
+    // differences, 8 (u8), 16 (u16) or 24 (f32) gathers and a brick lookup instead of six
     // trilinear samples.
     template <int W, class Scene>
     static RTFACT_INLINE Vec3<W> gradientFromBricks(const Scene& s, const Vec3<W>& p,

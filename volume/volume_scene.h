@@ -104,9 +104,9 @@ struct VolumeScene {
     // is larger than the last-level caches, where it waits on memory at every new brick.
     static constexpr size_t kPrefetchPoolBytes = size_t(64) << 20;
     bool prefetchBricks = false;
-    // Shaded: the voxels' central differences, per brick the TF shows (empty
-    // otherwise, or beyond kMaxGradientBytes and a quarter of the available memory: the
-    // march then takes six trilinear samples a gradient).
+    // Shaded: the voxels' central differences, per brick the TF shows (empty in the other
+    // modes, and beyond kMaxGradientBytes or a quarter of the available memory: the march
+    // then takes six trilinear samples a gradient).
     static constexpr uint64_t kMaxGradientBytes = uint64_t(1) << 30;
     GradientBricks gradients;
 
