@@ -170,9 +170,9 @@ void checkEqualsSixSamples() {
         Vec3<W> q;
         for (int i = 0; i < W; ++i) {
             Vec3f v(u(rng) * float(bv.dims[0] - 1), u(rng) * float(bv.dims[1] - 1), u(rng) * float(bv.dims[2] - 1));
-            if (it == 0) v[i % 3] = i % 2 ? float(bv.dims[i % 3] - 1) : 0.0f;       // the border
-            if (it == 1) v[i % 3] = float((i / 3 + 1) * 8 % (bv.dims[i % 3] - 1));  // brick faces
-            if (it == 2) v[i % 3] += 0.5f * float(i % 2 ? 1 : -1);                  // within a voxel of the border
+            if (it == 0) v[i % 3] = i % 2 ? float(bv.dims[i % 3] - 1) : 0.0f;         // the border
+            if (it == 1) v[i % 3] = float((i / 3 + 1) * 8 % (bv.dims[i % 3] - 1));    // brick faces
+            if (it == 2) v[i % 3] = i % 2 ? float(bv.dims[i % 3] - 1) - 0.4f : 0.4f;  // within a voxel of it
             q.setLane(i, v);
         }
         Vec3<W> six;
