@@ -35,10 +35,17 @@ float defaultIso(float lo, float hi) { return lo <= -500.0f ? 300.0f : lo + 0.4f
 
 template <class T>
 std::unique_ptr<Renderable> make(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& rs,
-                                 const TransferFunction& tf, std::pair<float, float> window, Stats& stats) {
-    auto scene = std::make_shared<VolumeScene<T>>(v, table, rs);
-    // shaded: the gradient bricks' memory (0: six samples a gradient)
-    if (rs.mode == VolumeMode::Shaded) stats.add("gradient_mb", double(scene->gradients.memoryBytes()) / 1048576.0);
+                                 const TransferFunction& tf, std::pair<float, float> window, Stats& stats,
+                                 std::shared_ptr<const GradientBricks>& gradientCache) {
+    auto scene = std::make_shared<VolumeScene<T>>(v, table, rs, gradientCache);
+    if (rs.mode == VolumeMode::Shaded) {
+        // the gradient bricks' memory (0: six samples a gradient), and whether the last
+        // shaded scene's were taken
+        const bool reused = scene->gradients && scene->gradients == gradientCache;
+        stats.add("gradient_mb", scene->gradients ? double(scene->gradients->memoryBytes()) / 1048576.0 : 0.0);
+        stats.add("gradients_reused", (unsigned long long)(reused ? 1 : 0));
+        if (scene->gradients) gradientCache = scene->gradients;
+    }
     auto r = std::make_unique<RenderableOf<VolumeScene<T>, VolumeIntegrator>>(scene, VolumeIntegrator{});
     r->stats = [name = tf.name, window](Stats& st, const RenderStats& rst) {
         const uint64_t samples = rst.counters.volumeSamples, skipped = rst.counters.volumeSkipped;
@@ -99,13 +106,13 @@ std::unique_ptr<Renderable> makeVolumeRenderable(SceneData& d, const VolumeSetti
     std::unique_ptr<Renderable> r;
     switch (vol.storage) {
         case Storage::U8:
-            r = make<uint8_t>(vol, table, rs, tf, window, stats);
+            r = make<uint8_t>(vol, table, rs, tf, window, stats, d.volume.gradients);
             break;
         case Storage::U16:
-            r = make<uint16_t>(vol, table, rs, tf, window, stats);
+            r = make<uint16_t>(vol, table, rs, tf, window, stats, d.volume.gradients);
             break;
         default:
-            r = make<float>(vol, table, rs, tf, window, stats);
+            r = make<float>(vol, table, rs, tf, window, stats, d.volume.gradients);
             break;
     }
     stats.add("build_ms", msSince(t0));

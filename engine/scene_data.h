@@ -11,6 +11,7 @@
 #include "points/point_cloud.h"
 #include "surfaces/mesh.h"
 #include "volume/brick_volume.h"
+#include "volume/gradient_bricks.h"
 
 namespace rtfact::engine::detail {
 
@@ -31,6 +32,9 @@ struct MeshData {
 
 struct VolumeData {
     volume::BrickedVolume vol;
+    // The last shaded scene's gradient bricks (of vol), offered to the next scene: a TF
+    // change that shows no new brick reuses them.
+    std::shared_ptr<const volume::GradientBricks> gradients;
 };
 
 struct SpheresData {

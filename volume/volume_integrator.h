@@ -147,7 +147,7 @@ struct VolumeIntegrator {
         }
         return g;
     }
-    // The same from the gradient bricks (VolumeScene::gradients, when built), for p in cell
+    // The same from the gradient bricks (VolumeScene::gradients, not null), for p in cell
     // `cell` of brick `brick`: the trilinear interpolation of the cell's eight central
     // differences, 8 (u8), 16 (u16) or 24 (f32) gathers and a brick lookup instead of six
     // trilinear samples.
@@ -160,7 +160,7 @@ struct VolumeIntegrator {
         using V = typename Scene::Voxel;
         constexpr int E = Scene::kEdge, B = std::is_same_v<V, float> ? 3 : int(sizeof(V));  // words an entry
         const I id = brick[0] + brick[1] * I(s.nbx) + brick[2] * I(s.nbxy);
-        const I base = gather(s.gradients.start.data(), id) +
+        const I base = gather(s.gradients->start.data(), id) +
                        ((cell[0] & I(7)) + (cell[1] & I(7)) * I(E) + (cell[2] & I(7)) * I(E * E)) * I(B);
         const P fx = p.x - toFloat(cell[0]), fy = p.y - toFloat(cell[1]), fz = p.z - toFloat(cell[2]);
         // corner (x, y, z) of the cell: entry x + E y + E^2 z from the cell's first
@@ -170,14 +170,14 @@ struct VolumeIntegrator {
             P g0[3], g1[3];
             if constexpr (B == 3) {
                 for (int a = 0; a < 3; ++a) {
-                    g0[a] = gather(s.gradients.values.data(), base + I(off + a));
-                    g1[a] = gather(s.gradients.values.data(), base + I(off + B + a));
+                    g0[a] = gather(s.gradients->values.data(), base + I(off + a));
+                    g1[a] = gather(s.gradients->values.data(), base + I(off + B + a));
                 }
             } else {
                 I w0[B], w1[B], d0[3], d1[3];
                 for (int k = 0; k < B; ++k) {
-                    w0[k] = gather(s.gradients.entries.data(), base + I(off + k));
-                    w1[k] = gather(s.gradients.entries.data(), base + I(off + B + k));
+                    w0[k] = gather(s.gradients->entries.data(), base + I(off + k));
+                    w1[k] = gather(s.gradients->entries.data(), base + I(off + B + k));
                 }
                 GradientBricks::decode<B>(w0, d0);
                 GradientBricks::decode<B>(w1, d1);
@@ -411,7 +411,7 @@ struct VolumeIntegrator {
                             Vec3<W> rgb(tr, tg, tb);
                             if constexpr (mode == VolumeMode::Shaded) {
                                 const Vec3<W> g =
-                                    !s.gradients.empty() ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
+                                    s.gradients ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
                                 rgb = rgb * shadeFactor<W>(g, d);
                             }
                             const P w = (P(1.0f) - alpha) * a;

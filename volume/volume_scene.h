@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "core/util/error.h"
@@ -109,10 +110,15 @@ struct VolumeScene {
     // then takes six trilinear samples a gradient). Measured (AVX-512, 1 thread): faster
     // with 56 MB of them (256^3 u16 phantom, 368 -> 314 ms), slower with 412 MB (512^3,
     // 548 -> 714 ms: six samples reread voxels the cache holds, the bricks miss).
+    // The bricks depend on the TF only through which bricks are shown: `reuse` (bricks an
+    // earlier scene of the same volume built) is taken when it holds every brick shown now,
+    // so a TF edit in the viewer does not rebuild them.
     static constexpr uint64_t kMaxGradientBytes = uint64_t(128) << 20;
-    GradientBricks gradients;
+    std::shared_ptr<const GradientBricks> gradients;  // null: none
 
-    VolumeScene(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& s) : settings(s), tf(table) {
+    VolumeScene(const BrickedVolume& v, const TFTable& table, const VolumeRenderSettings& s,
+                std::shared_ptr<const GradientBricks> reuse = {})
+        : settings(s), tf(table) {
         for (int a = 0; a < 3; ++a) {
             if (v.dims[a] < 2) throw Error("", "cannot render a volume with fewer than 2 voxels along an axis");
             dims[a] = v.dims[a];
@@ -171,7 +177,15 @@ struct VolumeScene {
             std::vector<uint8_t> shown(nc, 0);
             for (size_t i = 0; i < ns; ++i)
                 if (visible[i]) shown[brickOctant(i).first] = 1;
-            gradients = GradientBricks::build(v, shown, std::min(kMaxGradientBytes, availableMemoryBytes() / 4));
+            bool covered = reuse && reuse->start.size() == nc;
+            for (size_t b = 0; b < nc && covered; ++b) covered = !shown[b] || reuse->start[b] != 0;
+            if (covered) {
+                gradients = std::move(reuse);
+            } else {
+                GradientBricks g =
+                    GradientBricks::build(v, shown, std::min(kMaxGradientBytes, availableMemoryBytes() / 4));
+                if (!g.empty()) gradients = std::make_shared<const GradientBricks>(std::move(g));
+            }
         }
         subInfo.resize(ns);
         const std::vector<int32_t> steps = stepBits(v, visible);

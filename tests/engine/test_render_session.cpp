@@ -233,3 +233,24 @@ TEST(RenderSession, CancelledFirstPassLeavesNoStaleDepth) {
     ASSERT_EQ(f.rgba.size(), b.rgba.size());
     EXPECT_EQ(f.rgba, b.rgba);
 }
+
+// Shaded volumes: a settings change that shows no new brick (here the step) takes the
+// last scene's gradient bricks instead of rebuilding them, and the image is that of a
+// freshly opened scene (no bricks to reuse).
+TEST(RenderSession, ShadedVolumeReusesGradientBricks) {
+    const std::string tooth = std::string(RTFACT_DATASETS) + "/volumes/tooth_103x94x161_uint8.mhd";
+    const Scene s = openQuiet(tooth);
+    Settings shaded;
+    shaded.volume.mode = "shaded";
+    const CameraFrame cam = cameraOf(s, {0.6f, 0.45f, 1.0f});
+    RenderSession session(s, shaded, size(48, 48), cam);
+    session.renderPass();
+    EXPECT_EQ(session.buildStats().get("gradients_reused"), "0");
+    EXPECT_GT(std::stod(session.buildStats().get("gradient_mb")), 0.0);
+    Settings finer = shaded;
+    finer.volume.step = 0.7f;
+    session.setSettings(finer);
+    session.renderPass();
+    EXPECT_EQ(session.buildStats().get("gradients_reused"), "1");
+    EXPECT_EQ(session.frame().rgba, oneShot(openQuiet(tooth), finer, size(48, 48), cam, 1).rgba);
+}

@@ -162,8 +162,9 @@ template <int W, class T>
 void checkEqualsSixSamples() {
     const BrickedVolume bv = randomVolume<T>();
     VolumeScene<T> s = shadedScene<T>(bv);
-    ASSERT_FALSE(s.gradients.empty()) << "a shaded scene has gradient bricks";
-    s.gradients = GradientBricks::build(bv, std::vector<uint8_t>(bv.brickCount(), 1), uint64_t(1) << 30);
+    ASSERT_TRUE(s.gradients) << "a shaded scene has gradient bricks";
+    s.gradients = std::make_shared<const GradientBricks>(
+        GradientBricks::build(bv, std::vector<uint8_t>(bv.brickCount(), 1), uint64_t(1) << 30));
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (int it = 0; it < 300; ++it) {
@@ -211,9 +212,9 @@ void checkShadedImage() {
     ASSERT_EQ(bv.storage, storageOf<T>());
     for (bool skipping : {true, false}) {
         VolumeScene<T> s = shadedScene<T>(bv, skipping);
-        ASSERT_FALSE(s.gradients.empty());
+        ASSERT_TRUE(s.gradients);
         const std::vector<float> fast = render(s, 64);
-        s.gradients = {};
+        s.gradients = nullptr;
         const std::vector<float> six = render(s, 64);
         ASSERT_EQ(fast.size(), six.size());
         float maxDiff = 0, sum = 0;
@@ -228,8 +229,36 @@ void checkShadedImage() {
     VolumeRenderSettings dvr;
     const auto [lo, hi] = bv.valueRange();
     const TFTable table = buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, dvr.stepVoxels);
-    EXPECT_TRUE(VolumeScene<T>(bv, table, dvr).gradients.empty());
+    EXPECT_FALSE(VolumeScene<T>(bv, table, dvr).gradients);
 }
 TEST(GradientBricks, ShadedImageMatchesSixSamplesU8) { checkShadedImage<uint8_t>(); }
 TEST(GradientBricks, ShadedImageMatchesSixSamplesU16) { checkShadedImage<uint16_t>(); }
 TEST(GradientBricks, ShadedImageMatchesSixSamplesF32) { checkShadedImage<float>(); }
+
+// A scene takes the gradient bricks offered when they hold every brick it shows (same
+// image as its own), and builds its own when they do not.
+TEST(GradientBricks, SceneReusesBricksThatCoverItsBricks) {
+    const BrickedVolume bv = brickVolume(makeSheppLogan(45, Storage::U16));
+    const auto [lo, hi] = bv.valueRange();
+    VolumeRenderSettings rs;
+    rs.mode = VolumeMode::Shaded;
+    const TFTable bone = buildTable(transferFunctionPreset("ct-bone"), {lo, hi}, rs.stepVoxels);
+    const TFTable all = buildTable(transferFunctionPreset("grayscale"), {lo, hi}, rs.stepVoxels);
+    const VolumeScene<uint16_t> fewer(bv, bone, rs), more(bv, all, rs);
+    ASSERT_TRUE(fewer.gradients && more.gradients);
+    size_t nFewer = 0, nMore = 0;
+    for (size_t b = 0; b < bv.brickCount(); ++b) {
+        nFewer += fewer.gradients->start[b] != 0;
+        nMore += more.gradients->start[b] != 0;
+        ASSERT_TRUE(fewer.gradients->start[b] == 0 || more.gradients->start[b] != 0);
+    }
+    ASSERT_LT(nFewer, nMore) << "the grayscale TF shows more bricks than ct-bone";
+    // covered: taken, same image
+    const VolumeScene<uint16_t> reused(bv, bone, rs, more.gradients);
+    EXPECT_EQ(reused.gradients, more.gradients);
+    EXPECT_EQ(render(reused, 48), render(fewer, 48));
+    // not covered: its own
+    const VolumeScene<uint16_t> own(bv, all, rs, fewer.gradients);
+    EXPECT_NE(own.gradients, fewer.gradients);
+    EXPECT_EQ(render(own, 48), render(more, 48));
+}
