@@ -93,14 +93,27 @@ struct VolumeIntegrator {
     static RTFACT_INLINE Vec3<G> group(const Vec3<N>& v, int k) {
         return {group<G>(v.x, k), group<G>(v.y, k), group<G>(v.z, k)};
     }
+    // The brick grid index of brick coordinates b.
+    template <int W, class Scene>
+    static RTFACT_INLINE Packet<W, int32_t> brickId(const Scene& s, const Packet<W, int32_t> (&b)[3]) {
+        using I = Packet<W, int32_t>;
+        return b[0] + b[1] * I(s.nbx) + b[2] * I(s.nbxy);
+    }
+    // A cell's first sample inside its brick (8 cells a brick edge), for rows of R and
+    // slices of S entries.
+    template <int W, int R, int S>
+    static RTFACT_INLINE Packet<W, int32_t> cellInBrick(const Packet<W, int32_t> (&cell)[3]) {
+        using I = Packet<W, int32_t>;
+        return (cell[0] & I(7)) + (cell[1] & I(7)) * I(R) + (cell[2] & I(7)) * I(S);
+    }
     // Trilinear sample (stored units) at index-space p; p must be clamped into the grid.
     template <int W, VoxelLayout L = VoxelLayout::Rows, class Scene>
     static RTFACT_INLINE Packet<W> sample(const Scene& s, const Vec3<W>& p) {
         using I = Packet<W, int32_t>;
         static_assert(Scene::kCells == 8);
         const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
-        const I start =
-            gather(s.template entryStart<L>(), (cell[0] >> 3) + (cell[1] >> 3) * I(s.nbx) + (cell[2] >> 3) * I(s.nbxy));
+        const I brick[3] = {cell[0] >> 3, cell[1] >> 3, cell[2] >> 3};
+        const I start = gather(s.template entryStart<L>(), brickId<W>(s, brick));
         return sampleCell<W, L>(s, p, cell, start);
     }
     // The same with the cell (toInt of p) and its brick's first entry (in layout L) known.
@@ -111,8 +124,7 @@ struct VolumeIntegrator {
         using I = Packet<W, int32_t>;
         constexpr int R = Scene::template kRowStride<L>, S = Scene::template kSliceStride<L>;
         const P fx = p.x - toFloat(cell[0]), fy = p.y - toFloat(cell[1]), fz = p.z - toFloat(cell[2]);
-        // the cell's first entry inside its brick (8 cells a brick edge)
-        const I base = start + (cell[0] & I(7)) + (cell[1] & I(7)) * I(R) + (cell[2] & I(7)) * I(S);
+        const I base = start + cellInBrick<W, R, S>(cell);
         // rows (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1): a = x, b = x + 1
         P a0, b0, a1, b1, a2, b2, a3, b3;
         if constexpr (L == VoxelLayout::YPairs) {
@@ -159,9 +171,7 @@ struct VolumeIntegrator {
         using I = Packet<W, int32_t>;
         using V = typename Scene::Voxel;
         constexpr int E = Scene::kEdge, B = std::is_same_v<V, float> ? 3 : int(sizeof(V));  // words an entry
-        const I id = brick[0] + brick[1] * I(s.nbx) + brick[2] * I(s.nbxy);
-        const I base = gather(s.gradients->start.data(), id) +
-                       ((cell[0] & I(7)) + (cell[1] & I(7)) * I(E) + (cell[2] & I(7)) * I(E * E)) * I(B);
+        const I base = gather(s.gradients->start.data(), brickId<W>(s, brick)) + cellInBrick<W, E, E * E>(cell) * I(B);
         const P fx = p.x - toFloat(cell[0]), fy = p.y - toFloat(cell[1]), fz = p.z - toFloat(cell[2]);
         // corner (x, y, z) of the cell: entry x + E y + E^2 z from the cell's first
         Vec3<W> row[4];  // the x-lerps of rows (y, z) = (0, 0), (1, 0), (0, 1), (1, 1)
