@@ -88,11 +88,16 @@ struct WideSAHBVHBuilder {
         // block's own bins (the partition then needs no counting pass).
         std::vector<uint32_t> blockLeft;
     };
-    // Per axis and bin: bounds (lo, hi) and count. Only the first n bins are set up (small
-    // ranges use few bins: clearing all of them would cost more than binning).
+    // Per axis and bin: bounds (lo, hi) and count, flat: axis a's bin k at a * kMaxBins + k
+    // (one index addresses a bin's box and its count). Only the first n bins of each axis
+    // are set up (small ranges use few bins: clearing all of them would cost more than
+    // binning).
     struct Bins {
-        __m128 lo[3][kMaxBins], hi[3][kMaxBins];
-        uint32_t count[3][kMaxBins];
+        struct alignas(32) Box {
+            __m128 lo, hi;
+        };
+        Box box[3 * kMaxBins];
+        uint32_t cnt[3 * kMaxBins];
         int n = 0;
         Bins() {}  // NOLINT: unset, no zeroing (a slot that init() sets up later)
         explicit Bins(int nb) { init(nb); }
@@ -101,22 +106,24 @@ struct WideSAHBVHBuilder {
             const __m128 inf = _mm_set1_ps(kInf), ninf = _mm_set1_ps(-kInf);
             for (int a = 0; a < 3; ++a)
                 for (int k = 0; k < nb; ++k) {
-                    lo[a][k] = inf;
-                    hi[a][k] = ninf;
-                    count[a][k] = 0;
+                    box[a * kMaxBins + k] = {inf, ninf};
+                    cnt[a * kMaxBins + k] = 0;
                 }
         }
-        RTFACT_INLINE void add(int a, int k, __m128 l, __m128 h) {
-            lo[a][k] = _mm_min_ps(lo[a][k], l);
-            hi[a][k] = _mm_max_ps(hi[a][k], h);
-            count[a][k]++;
+        __m128 lo(int a, int k) const { return box[a * kMaxBins + k].lo; }
+        __m128 hi(int a, int k) const { return box[a * kMaxBins + k].hi; }
+        uint32_t count(int a, int k) const { return cnt[a * kMaxBins + k]; }
+        RTFACT_INLINE void add(int i, __m128 l, __m128 h) {
+            box[i].lo = _mm_min_ps(box[i].lo, l);
+            box[i].hi = _mm_max_ps(box[i].hi, h);
+            cnt[i]++;
         }
         void merge(const Bins& o) {
             for (int a = 0; a < 3; ++a)
-                for (int k = 0; k < n; ++k) {
-                    lo[a][k] = _mm_min_ps(lo[a][k], o.lo[a][k]);
-                    hi[a][k] = _mm_max_ps(hi[a][k], o.hi[a][k]);
-                    count[a][k] += o.count[a][k];
+                for (int k = a * kMaxBins; k < a * kMaxBins + n; ++k) {
+                    box[k].lo = _mm_min_ps(box[k].lo, o.box[k].lo);
+                    box[k].hi = _mm_max_ps(box[k].hi, o.box[k].hi);
+                    cnt[k] += o.cnt[k];
                 }
         }
     };
@@ -160,29 +167,38 @@ struct WideSAHBVHBuilder {
     // wait on each other's read-modify-write of that bin.
     static void binRange(const Ref* refs, uint32_t b, uint32_t e, const Split& s, Bins& bins) {
         const __m128i maxBin = _mm_set1_epi32(s.bins - 1);
-        alignas(16) int32_t k0[4], k1[4];
+        const __m128i axisBase = _mm_setr_epi32(0, kMaxBins, 2 * kMaxBins, 0);
+        // a reference's three flat bin indices
+        auto flat = [&](const Ref& r) __attribute__((always_inline)) {
+            return _mm_add_epi32(binOf(r, s.cmin, s.scale, maxBin), axisBase);
+        };
         uint32_t i = b;
         if (e - b >= kTwoBinSets) {
             Bins other(s.bins);
             for (; i + 1 < e; i += 2) {
+                // the hardware prefetcher falls behind on ranges beyond the caches
+                _mm_prefetch(reinterpret_cast<const char*>(refs + i + 32), _MM_HINT_T0);
                 const Ref& r0 = refs[i];
                 const Ref& r1 = refs[i + 1];
-                _mm_store_si128(reinterpret_cast<__m128i*>(k0), binOf(r0, s.cmin, s.scale, maxBin));
-                _mm_store_si128(reinterpret_cast<__m128i*>(k1), binOf(r1, s.cmin, s.scale, maxBin));
+                const __m128i k0 = flat(r0), k1 = flat(r1);
                 const __m128 l0 = _mm_load_ps(r0.lo), h0 = _mm_load_ps(r0.hi);
                 const __m128 l1 = _mm_load_ps(r1.lo), h1 = _mm_load_ps(r1.hi);
-                for (int a = 0; a < 3; ++a) {
-                    bins.add(a, k0[a], l0, h0);
-                    other.add(a, k1[a], l1, h1);
-                }
+                bins.add(_mm_cvtsi128_si32(k0), l0, h0);
+                other.add(_mm_cvtsi128_si32(k1), l1, h1);
+                bins.add(_mm_extract_epi32(k0, 1), l0, h0);
+                other.add(_mm_extract_epi32(k1, 1), l1, h1);
+                bins.add(_mm_extract_epi32(k0, 2), l0, h0);
+                other.add(_mm_extract_epi32(k1, 2), l1, h1);
             }
             bins.merge(other);
         }
         for (; i < e; ++i) {
             const Ref& r = refs[i];
-            _mm_store_si128(reinterpret_cast<__m128i*>(k0), binOf(r, s.cmin, s.scale, maxBin));
+            const __m128i k = flat(r);
             const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi);
-            for (int a = 0; a < 3; ++a) bins.add(a, k0[a], l, h);
+            bins.add(_mm_cvtsi128_si32(k), l, h);
+            bins.add(_mm_extract_epi32(k, 1), l, h);
+            bins.add(_mm_extract_epi32(k, 2), l, h);
         }
     }
 
@@ -220,15 +236,15 @@ struct WideSAHBVHBuilder {
             Box4 acc;
             uint32_t cnt = 0;
             for (int k = s.bins - 1; k > 0; --k) {
-                acc.extend(bins.lo[a][k], bins.hi[a][k]);
-                cnt += bins.count[a][k];
+                acc.extend(bins.lo(a, k), bins.hi(a, k));
+                cnt += bins.count(a, k);
                 rightCost[k] = cnt ? acc.halfArea() * blocks(cnt) : -1.0f;
             }
             acc = Box4{};
             cnt = 0;
             for (int k = 0; k < s.bins - 1; ++k) {
-                acc.extend(bins.lo[a][k], bins.hi[a][k]);
-                cnt += bins.count[a][k];
+                acc.extend(bins.lo(a, k), bins.hi(a, k));
+                cnt += bins.count(a, k);
                 if (cnt == 0 || rightCost[k + 1] < 0.0f) continue;
                 const float cost = acc.halfArea() * blocks(cnt) + rightCost[k + 1];
                 if (cost < s.cost) {
@@ -242,7 +258,7 @@ struct WideSAHBVHBuilder {
             s.blockLeft.resize(blockBins.size());
             for (size_t bi = 0; bi < blockBins.size(); ++bi) {
                 uint32_t c = 0;
-                for (int k = 0; k <= s.pos; ++k) c += blockBins[bi].count[s.axis][k];
+                for (int k = 0; k <= s.pos; ++k) c += blockBins[bi].count(s.axis, k);
                 s.blockLeft[bi] = c;
             }
         }
@@ -272,27 +288,57 @@ struct WideSAHBVHBuilder {
         const float sc = scl[a], cm = cmn[a];
         auto left = [=](const Ref& x) { return std::min(int((x.lo[a] + x.hi[a] - cm) * sc), maxBin) <= pos; };
         if (s.blockLeft.empty()) {
-            // Local accumulators: the swaps may alias l and rr for the compiler, which
-            // would then store them on every element.
-            Box4 lb, lc, rb, rc;
-            uint32_t i = r.b, j = r.e;
-            for (;;) {
-                while (i < j && left(src[i])) {
-                    extend(lb, lc, src[i]);
-                    ++i;
-                }
-                while (i < j && !left(src[j - 1])) {
-                    --j;
-                    extend(rb, rc, src[j]);
-                }
-                if (i >= j) break;
-                std::swap(src[i], src[j - 1]);
-            }
-            l.box = lb, l.cbox = lc, rr.box = rb, rr.cbox = rc;
-            l.b = r.b, l.e = i, rr.b = i, rr.e = r.e;
+            partitionSerial(src, r, left, l, rr);
             return;
         }
         partitionParallel(ctx, r, s, l, rr);
+    }
+
+    // In place, with no branch on a reference's side (one mispredicted per reference cost
+    // more than the rest of the pass): BlockQuicksort's scheme (Edelkamp and Weiss 2016).
+    // kBlock references from each end are classified into lists of the misplaced ones,
+    // then misplaced pairs swap; the last few go through a plain two-sided pass. The
+    // children's bounds come from one pass over each child afterwards (in cache: cheaper
+    // than sorting every reference's box into one of two by its side).
+    template <class Left>
+    static void partitionSerial(Ref* src, const Range& r, const Left& left, Range& l, Range& rr) {
+        constexpr uint32_t kBlock = 64;
+        uint32_t i = r.b, j = r.e;  // [i, j) not yet in place
+        uint8_t offL[kBlock], offR[kBlock];
+        uint32_t nL = 0, nR = 0, sL = 0, sR = 0;  // misplaced in [i, i + kBlock) and in [j - kBlock, j)
+        while (j - i >= 2 * kBlock) {
+            if (nL == 0) {
+                sL = 0;
+                for (uint32_t k = 0; k < kBlock; ++k) {
+                    offL[nL] = uint8_t(k);
+                    nL += !left(src[i + k]);
+                }
+            }
+            if (nR == 0) {
+                sR = 0;
+                for (uint32_t k = 0; k < kBlock; ++k) {
+                    offR[nR] = uint8_t(k);
+                    nR += left(src[j - 1 - k]);
+                }
+            }
+            const uint32_t m = std::min(nL, nR);
+            for (uint32_t k = 0; k < m; ++k) std::swap(src[i + offL[sL + k]], src[j - 1 - offR[sR + k]]);
+            nL -= m, nR -= m, sL += m, sR += m;
+            if (nL == 0) i += kBlock;
+            if (nR == 0) j -= kBlock;
+        }
+        for (;;) {
+            while (i < j && left(src[i])) ++i;
+            while (i < j && !left(src[j - 1])) --j;
+            if (i >= j) break;
+            std::swap(src[i], src[j - 1]);
+        }
+        l.b = r.b, l.e = i, rr.b = i, rr.e = r.e;
+        for (Range* c : {&l, &rr}) {
+            Box4 box, cbox;
+            for (uint32_t k = c->b; k < c->e; ++k) extend(box, cbox, src[k]);
+            c->box = box, c->cbox = cbox;
+        }
     }
 
     // In place in parallel, in two passes over kGrain blocks and no second buffer (its
