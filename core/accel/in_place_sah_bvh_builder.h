@@ -44,7 +44,7 @@ struct InPlaceSAHBVHBuilder {
     };
     static RTFACT_INLINE __m128 lo4(const Ref& r) { return _mm_load_ps(r.lo); }
     static RTFACT_INLINE __m128 hi4(const Ref& r) { return _mm_load_ps(r.hi); }
-    static RTFACT_INLINE __m128 c2(const Ref& r) { return _mm_add_ps(lo4(r), hi4(r)); }  // twice the centroid
+    static RTFACT_INLINE __m128 c2(const Ref& r) { return doubledCentroid(lo4(r), hi4(r)); }
 
    public:
     void build(std::span<const AABB> bounds, BVHTopology& out) const {
@@ -118,7 +118,7 @@ struct InPlaceSAHBVHBuilder {
                 const Ref& r = ctx.refs[i];
                 const __m128 l = lo4(r), h = hi4(r);
                 const __m128i k =
-                    _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_add_ps(l, h), cmin), sc)), maxBin);
+                    _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(doubledCentroid(l, h), cmin), sc)), maxBin);
                 alignas(16) int32_t ki[4];
                 _mm_store_si128(reinterpret_cast<__m128i*>(ki), k);
                 for (int a = 0; a < 3; ++a) {

@@ -69,7 +69,7 @@ struct WideSAHBVHBuilder {
     };
     // Adds a reference to a box and its doubled centroid to a centroid box.
     static RTFACT_INLINE void extend(Box4& box, Box4& cbox, const Ref& r) {
-        const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi), c = _mm_add_ps(l, h);
+        const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi), c = doubledCentroid(l, h);
         box.extend(l, h);
         cbox.extend(c, c);
     }
@@ -158,7 +158,7 @@ struct WideSAHBVHBuilder {
     float blocks(uint32_t n) const { return float((n + uint32_t(leafBlock) - 1) / uint32_t(leafBlock)); }
 
     static RTFACT_INLINE __m128i binOf(const Ref& r, __m128 cmin, __m128 scale, __m128i maxBin) {
-        const __m128 c = _mm_add_ps(_mm_load_ps(r.lo), _mm_load_ps(r.hi));
+        const __m128 c = doubledCentroid(_mm_load_ps(r.lo), _mm_load_ps(r.hi));
         return _mm_min_epi32(_mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, cmin), scale)), maxBin);
     }
 

@@ -2,9 +2,11 @@
 // it overlaps the cell (kd-tree), children inside parents, SAH no worse than a median split.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <functional>
 #include <random>
 
+#include "core/accel/box4.h"
 #include "core/accel/median_bvh_builder.h"
 #include "core/accel/sah_bvh_builder.h"
 #include "core/accel/sah_kdtree_builder.h"
@@ -122,4 +124,19 @@ TEST(Builders, SAHKdTreeInvariants) {
     };
     walk(0, t.box, 0);
     for (size_t i = 0; i < seen.size(); ++i) EXPECT_GE(seen[i], 1) << "element " << i << " unreachable";
+}
+
+// The builders keep an element id in lo's fourth lane; the centroid they bin by must not
+// carry it (ids read as denormals or NaNs: a slow path for the add, and garbage in lane 3).
+TEST(Builders, DoubledCentroidIgnoresTheIdLane) {
+    for (uint32_t id : {1u, 12345u, (1u << 23) - 1u, 0x7f800001u, 0xffffffffu}) {
+        alignas(16) float lo[4] = {-1.5f, 2.0f, 1e-3f, 0.0f}, hi[4] = {0.5f, 3.0f, 4.0f, 0.0f};
+        std::memcpy(&lo[3], &id, 4);
+        alignas(16) float c[4];
+        _mm_store_ps(c, doubledCentroid(_mm_load_ps(lo), _mm_load_ps(hi)));
+        for (int a = 0; a < 3; ++a) EXPECT_EQ(c[a], lo[a] + hi[a]) << "id " << id;
+        uint32_t bits;
+        std::memcpy(&bits, &c[3], 4);
+        EXPECT_EQ(bits, 0u) << "id " << id;
+    }
 }
