@@ -12,9 +12,11 @@
 #include <atomic>
 #include <cstring>
 #include <limits>
+#include <new>
 #include <span>
 #include <vector>
 
+#include "core/accel/block_partition.h"
 #include "core/accel/box4.h"
 #include "core/accel/bvh.h"
 #include "core/simd/native.h"
@@ -108,12 +110,18 @@ struct InPlaceSAHBVHBuilder {
         float bestCost = kInfinityF;
         alignas(16) float scale[4] = {0, 0, 0, 0};
         const __m128 cmin = _mm_setr_ps(cb.lo.x, cb.lo.y, cb.lo.z, 0.0f);
+        // Fewer bins for small ranges: setting up and sweeping all of them cost more than
+        // binning the few references (most nodes are small).
+        const int nb = std::min(kBins, 4 + int(n / 8));
         if (maxComponent(ext) > 0.0f) {
-            for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(kBins) * 0.99999f / ext[a] : 0.0f;
+            for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(nb) * 0.99999f / ext[a] : 0.0f;
             const __m128 sc = _mm_load_ps(scale);
-            const __m128i maxBin = _mm_set1_epi32(kBins - 1);
-            Box4 bins[3][kBins];
-            uint32_t counts[3][kBins] = {};
+            const __m128i maxBin = _mm_set1_epi32(nb - 1);
+            alignas(Box4) unsigned char binStore[sizeof(Box4) * 3 * kBins];  // only nb per axis set up
+            auto bins = reinterpret_cast<Box4(*)[kBins]>(binStore);
+            uint32_t counts[3][kBins];
+            for (int a = 0; a < 3; ++a)
+                for (int k = 0; k < nb; ++k) new (&bins[a][k]) Box4, counts[a][k] = 0;
             for (uint32_t i = b; i < e; ++i) {
                 const Ref& r = ctx.refs[i];
                 const __m128 l = lo4(r), h = hi4(r);
@@ -133,7 +141,7 @@ struct InPlaceSAHBVHBuilder {
                 uint32_t rightCount[kBins];
                 Box4 acc;
                 uint32_t cnt = 0;
-                for (int k = kBins - 1; k > 0; --k) {
+                for (int k = nb - 1; k > 0; --k) {
                     acc.extend(bins[a][k]);
                     cnt += counts[a][k];
                     rightArea[k] = acc.area();
@@ -141,7 +149,7 @@ struct InPlaceSAHBVHBuilder {
                 }
                 acc = Box4{};
                 cnt = 0;
-                for (int k = 0; k < kBins - 1; ++k) {
+                for (int k = 0; k < nb - 1; ++k) {
                     acc.extend(bins[a][k]);
                     cnt += counts[a][k];
                     if (cnt == 0 || rightCount[k + 1] == 0) continue;
@@ -159,34 +167,15 @@ struct InPlaceSAHBVHBuilder {
         if (n <= uint32_t(maxLeafSize) && (axis < 0 || splitCost >= intersectionCost * float(n)))
             return makeLeaf(ctx, ni, b, e, box);
 
-        // Partition in place, gathering both halves' bounds on the way.
+        // Partition in place (no branch per reference), with both halves' bounds.
         Box4 lbox, lcbox, rbox, rcbox;
         uint32_t mid;
         if (axis >= 0) {
             const float s = scale[axis], lo = cb.lo[axis];
             auto left = [&](const Ref& r) {
-                return std::min(int((r.lo[axis] + r.hi[axis] - lo) * s), kBins - 1) <= split;
+                return std::min(int((r.lo[axis] + r.hi[axis] - lo) * s), nb - 1) <= split;
             };
-            uint32_t i = b, j = e;
-            while (true) {
-                while (i < j && left(ctx.refs[i])) {
-                    const Ref& r = ctx.refs[i];
-                    lbox.extend(lo4(r), hi4(r));
-                    const __m128 c = c2(r);
-                    lcbox.extend(c, c);
-                    ++i;
-                }
-                while (i < j && !left(ctx.refs[j - 1])) {
-                    --j;
-                    const Ref& r = ctx.refs[j];
-                    rbox.extend(lo4(r), hi4(r));
-                    const __m128 c = c2(r);
-                    rcbox.extend(c, c);
-                }
-                if (i >= j) break;
-                std::swap(ctx.refs[i], ctx.refs[j - 1]);
-            }
-            mid = i;
+            mid = blockPartition(ctx.refs, b, e, left, lbox, lcbox, rbox, rcbox);
         } else {
             // All centroids coincide: split the range in the middle.
             mid = b + n / 2;

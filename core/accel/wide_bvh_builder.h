@@ -34,6 +34,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/accel/block_partition.h"
 #include "core/accel/box4.h"
 #include "core/accel/wide_bvh.h"
 #include "core/util/huge_pages.h"
@@ -288,57 +289,11 @@ struct WideSAHBVHBuilder {
         const float sc = scl[a], cm = cmn[a];
         auto left = [=](const Ref& x) { return std::min(int((x.lo[a] + x.hi[a] - cm) * sc), maxBin) <= pos; };
         if (s.blockLeft.empty()) {
-            partitionSerial(src, r, left, l, rr);
+            const uint32_t mid = blockPartition(src, r.b, r.e, left, l.box, l.cbox, rr.box, rr.cbox);
+            l.b = r.b, l.e = mid, rr.b = mid, rr.e = r.e;
             return;
         }
         partitionParallel(ctx, r, s, l, rr);
-    }
-
-    // In place, with no branch on a reference's side (one mispredicted per reference cost
-    // more than the rest of the pass): BlockQuicksort's scheme (Edelkamp and Weiss 2016).
-    // kBlock references from each end are classified into lists of the misplaced ones,
-    // then misplaced pairs swap; the last few go through a plain two-sided pass. The
-    // children's bounds come from one pass over each child afterwards (in cache: cheaper
-    // than sorting every reference's box into one of two by its side).
-    template <class Left>
-    static void partitionSerial(Ref* src, const Range& r, const Left& left, Range& l, Range& rr) {
-        constexpr uint32_t kBlock = 64;
-        uint32_t i = r.b, j = r.e;  // [i, j) not yet in place
-        uint8_t offL[kBlock], offR[kBlock];
-        uint32_t nL = 0, nR = 0, sL = 0, sR = 0;  // misplaced in [i, i + kBlock) and in [j - kBlock, j)
-        while (j - i >= 2 * kBlock) {
-            if (nL == 0) {
-                sL = 0;
-                for (uint32_t k = 0; k < kBlock; ++k) {
-                    offL[nL] = uint8_t(k);
-                    nL += !left(src[i + k]);
-                }
-            }
-            if (nR == 0) {
-                sR = 0;
-                for (uint32_t k = 0; k < kBlock; ++k) {
-                    offR[nR] = uint8_t(k);
-                    nR += left(src[j - 1 - k]);
-                }
-            }
-            const uint32_t m = std::min(nL, nR);
-            for (uint32_t k = 0; k < m; ++k) std::swap(src[i + offL[sL + k]], src[j - 1 - offR[sR + k]]);
-            nL -= m, nR -= m, sL += m, sR += m;
-            if (nL == 0) i += kBlock;
-            if (nR == 0) j -= kBlock;
-        }
-        for (;;) {
-            while (i < j && left(src[i])) ++i;
-            while (i < j && !left(src[j - 1])) --j;
-            if (i >= j) break;
-            std::swap(src[i], src[j - 1]);
-        }
-        l.b = r.b, l.e = i, rr.b = i, rr.e = r.e;
-        for (Range* c : {&l, &rr}) {
-            Box4 box, cbox;
-            for (uint32_t k = c->b; k < c->e; ++k) extend(box, cbox, src[k]);
-            c->box = box, c->cbox = cbox;
-        }
     }
 
     // In place in parallel, in two passes over kGrain blocks and no second buffer (its
