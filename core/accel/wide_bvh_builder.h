@@ -13,7 +13,8 @@
 // parallel, one bin set per block of kGrain references, and partition in place in
 // parallel (partitionParallel: no second reference buffer, whose first-touch page faults
 // cost more than the pass it saved). Every other range is binned and partitioned
-// serially in place inside parallel subtree tasks. The depth-first reorder of the nodes
+// serially in place inside parallel subtree tasks (blockPartition: no branch on a
+// reference's side). The id lane never enters arithmetic (doubledCentroid). The depth-first reorder of the nodes
 // runs as parallel tasks too (subtree sizes fix every position up front). Scratch nodes
 // live on huge pages (page faults cost more than the binning on VMs), and the element
 // bounds can come from a function (no bounds array to fill and fault in first).
@@ -177,8 +178,6 @@ struct WideSAHBVHBuilder {
         if (e - b >= kTwoBinSets) {
             Bins other(s.bins);
             for (; i + 1 < e; i += 2) {
-                // the hardware prefetcher falls behind on ranges beyond the caches
-                _mm_prefetch(reinterpret_cast<const char*>(refs + i + 32), _MM_HINT_T0);
                 const Ref& r0 = refs[i];
                 const Ref& r1 = refs[i + 1];
                 const __m128i k0 = flat(r0), k1 = flat(r1);
