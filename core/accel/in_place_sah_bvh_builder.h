@@ -1,8 +1,8 @@
 // Binned SAH BVH builder on primitive references that are partitioned in place (no
-// indirection through an order array while building), with the bounds and centroid
-// bounds of both halves gathered during the partition pass, so every level costs one
-// binning and one partition sweep over contiguous memory. Subtrees are built in
-// parallel with TBB. Works on bounds only, like every builder.
+// indirection through an order array while building; blockPartition, which also gives
+// both halves' bounds and centroid bounds), so every level costs one binning and one
+// partition over contiguous memory. Subtrees are built in parallel with TBB. Works on
+// bounds only, like every builder.
 #pragma once
 #include <immintrin.h>
 #include <tbb/parallel_for.h>
