@@ -57,11 +57,7 @@ uint32_t blockPartition(Ref* src, uint32_t b, uint32_t e, const Left& left, Box4
     }
     auto bounds = [&](uint32_t from, uint32_t to, Box4& box, Box4& cbox) {
         Box4 bx, cb;  // locals: the stores through the references could alias the refs
-        for (uint32_t k = from; k < to; ++k) {
-            const __m128 lo = _mm_load_ps(src[k].lo), hi = _mm_load_ps(src[k].hi), c = doubledCentroid(lo, hi);
-            bx.extend(lo, hi);
-            cb.extend(c, c);
-        }
+        for (uint32_t k = from; k < to; ++k) extendWithCentroid(bx, cb, _mm_load_ps(src[k].lo), _mm_load_ps(src[k].hi));
         box = bx, cbox = cb;
     };
     bounds(b, i, lbox, lcbox);

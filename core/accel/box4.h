@@ -44,5 +44,12 @@ struct Box4 {
 RTFACT_INLINE __m128 doubledCentroid(__m128 lo, __m128 hi) {
     return _mm_add_ps(_mm_blend_ps(lo, _mm_setzero_ps(), 8), hi);
 }
+// Adds a reference's box (lo, hi) to box and its doubled centroid to cbox (the bounds and
+// centroid bounds the SAH builders keep per range).
+RTFACT_INLINE void extendWithCentroid(Box4& box, Box4& cbox, __m128 lo, __m128 hi) {
+    const __m128 c = doubledCentroid(lo, hi);
+    box.extend(lo, hi);
+    cbox.extend(c, c);
+}
 
 }  // namespace rtfact

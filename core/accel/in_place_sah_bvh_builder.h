@@ -12,7 +12,6 @@
 #include <atomic>
 #include <cstring>
 #include <limits>
-#include <new>
 #include <span>
 #include <vector>
 
@@ -44,9 +43,13 @@ struct InPlaceSAHBVHBuilder {
         BVHNode* nodes;
         std::atomic<uint32_t>& next;
     };
+    // A bin's bounds, without Box4's initialisers (those would set up all kBins bins of
+    // every node; only the ones in use are).
+    struct Bin {
+        __m128 lo, hi;
+    };
     static RTFACT_INLINE __m128 lo4(const Ref& r) { return _mm_load_ps(r.lo); }
     static RTFACT_INLINE __m128 hi4(const Ref& r) { return _mm_load_ps(r.hi); }
-    static RTFACT_INLINE __m128 c2(const Ref& r) { return doubledCentroid(lo4(r), hi4(r)); }
 
    public:
     void build(std::span<const AABB> bounds, BVHTopology& out) const {
@@ -64,9 +67,7 @@ struct InPlaceSAHBVHBuilder {
             r = {{bounds[i].lo.x, bounds[i].lo.y, bounds[i].lo.z, 0.0f},
                  {bounds[i].hi.x, bounds[i].hi.y, bounds[i].hi.z, 0.0f}};
             std::memcpy(&r.lo[3], &i, 4);
-            box.extend(lo4(r), hi4(r));
-            const __m128 c = c2(r);
-            cbox.extend(c, c);
+            extendWithCentroid(box, cbox, lo4(r), hi4(r));
         }
         std::vector<BVHNode> nodes;
         resizeHugePages(nodes, 2 * size_t(n));
@@ -117,11 +118,11 @@ struct InPlaceSAHBVHBuilder {
             for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0.0f ? float(nb) * 0.99999f / ext[a] : 0.0f;
             const __m128 sc = _mm_load_ps(scale);
             const __m128i maxBin = _mm_set1_epi32(nb - 1);
-            alignas(Box4) unsigned char binStore[sizeof(Box4) * 3 * kBins];  // only nb per axis set up
-            auto bins = reinterpret_cast<Box4(*)[kBins]>(binStore);
+            Bin bins[3][kBins];  // only nb per axis set up
             uint32_t counts[3][kBins];
+            const Box4 empty;
             for (int a = 0; a < 3; ++a)
-                for (int k = 0; k < nb; ++k) new (&bins[a][k]) Box4, counts[a][k] = 0;
+                for (int k = 0; k < nb; ++k) bins[a][k] = {empty.lo, empty.hi}, counts[a][k] = 0;
             for (uint32_t i = b; i < e; ++i) {
                 const Ref& r = ctx.refs[i];
                 const __m128 l = lo4(r), h = hi4(r);
@@ -131,7 +132,9 @@ struct InPlaceSAHBVHBuilder {
                 _mm_store_si128(reinterpret_cast<__m128i*>(ki), k);
                 for (int a = 0; a < 3; ++a) {
                     counts[a][ki[a]]++;
-                    bins[a][ki[a]].extend(l, h);
+                    Bin& bin = bins[a][ki[a]];
+                    bin.lo = _mm_min_ps(bin.lo, l);
+                    bin.hi = _mm_max_ps(bin.hi, h);
                 }
             }
             // Sweep: right-to-left areas, then left-to-right costs.
@@ -142,7 +145,7 @@ struct InPlaceSAHBVHBuilder {
                 Box4 acc;
                 uint32_t cnt = 0;
                 for (int k = nb - 1; k > 0; --k) {
-                    acc.extend(bins[a][k]);
+                    acc.extend(bins[a][k].lo, bins[a][k].hi);
                     cnt += counts[a][k];
                     rightArea[k] = acc.area();
                     rightCount[k] = cnt;
@@ -150,7 +153,7 @@ struct InPlaceSAHBVHBuilder {
                 acc = Box4{};
                 cnt = 0;
                 for (int k = 0; k < nb - 1; ++k) {
-                    acc.extend(bins[a][k]);
+                    acc.extend(bins[a][k].lo, bins[a][k].hi);
                     cnt += counts[a][k];
                     if (cnt == 0 || rightCount[k + 1] == 0) continue;
                     const float cost = acc.area() * float(cnt) + rightArea[k + 1] * float(rightCount[k + 1]);
@@ -181,14 +184,10 @@ struct InPlaceSAHBVHBuilder {
             mid = b + n / 2;
             for (uint32_t i = b; i < e; ++i) {
                 const Ref& r = ctx.refs[i];
-                const __m128 c = c2(r);
-                if (i < mid) {
-                    lbox.extend(lo4(r), hi4(r));
-                    lcbox.extend(c, c);
-                } else {
-                    rbox.extend(lo4(r), hi4(r));
-                    rcbox.extend(c, c);
-                }
+                if (i < mid)
+                    extendWithCentroid(lbox, lcbox, lo4(r), hi4(r));
+                else
+                    extendWithCentroid(rbox, rcbox, lo4(r), hi4(r));
             }
         }
         const uint32_t left = ctx.next.fetch_add(2);

@@ -14,10 +14,11 @@
 // parallel (partitionParallel: no second reference buffer, whose first-touch page faults
 // cost more than the pass it saved). Every other range is binned and partitioned
 // serially in place inside parallel subtree tasks (blockPartition: no branch on a
-// reference's side). The id lane never enters arithmetic (doubledCentroid). The depth-first reorder of the nodes
-// runs as parallel tasks too (subtree sizes fix every position up front). Scratch nodes
-// live on huge pages (page faults cost more than the binning on VMs), and the element
-// bounds can come from a function (no bounds array to fill and fault in first).
+// reference's side). The id lane never enters arithmetic (doubledCentroid). The
+// depth-first reorder of the nodes runs as parallel tasks too (subtree sizes fix every
+// position up front). Scratch nodes live on huge pages (page faults cost more than the
+// binning on VMs), and the element bounds can come from a function (no bounds array to
+// fill and fault in first).
 #pragma once
 #include <immintrin.h>
 #include <tbb/blocked_range.h>
@@ -71,9 +72,7 @@ struct WideSAHBVHBuilder {
     };
     // Adds a reference to a box and its doubled centroid to a centroid box.
     static RTFACT_INLINE void extend(Box4& box, Box4& cbox, const Ref& r) {
-        const __m128 l = _mm_load_ps(r.lo), h = _mm_load_ps(r.hi), c = doubledCentroid(l, h);
-        box.extend(l, h);
-        cbox.extend(c, c);
+        extendWithCentroid(box, cbox, _mm_load_ps(r.lo), _mm_load_ps(r.hi));
     }
     // A range of references with its bounds and the bounds of its doubled centroids.
     struct Range {
