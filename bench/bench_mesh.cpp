@@ -444,8 +444,9 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     auto meshPtr = std::make_shared<const Mesh>(mesh);
     const std::vector<int> threadCounts = allThreads > 1 ? std::vector<int>{1, allThreads} : std::vector<int>{1};
     // RTfact's wide BVH alone (packet traversal for primary and shadow rays, single rays
-    // for secondaries), and the binary packet BVH that the renderer's primary and shadow
-    // rays use (its build, memory and packet traversal).
+    // for secondaries: the renderer's mesh scene), and the binary packet BVH that
+    // `--secondary packet` builds instead (its build, memory and packet traversal; the
+    // `rtfact=` / `ratio=` figures).
     MeshScene<BVH<Triangle>> scene, pscene;
     scene.mesh = pscene.mesh = meshPtr;
     scene.packetBVHMaxTriangles = 0;  // the wide BVH alone

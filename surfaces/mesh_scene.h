@@ -127,12 +127,14 @@ struct MeshScene {
     // Coherent rays (primary, packet secondaries) take the binary packet BVH when it is
     // built, else the wide BVH's packet traversal (WideBVHPacketIntersector); coherent
     // shadow rays take the wide packets whenever the wide BVH exists (occluded()).
-    // The binary one is built for meshes of at most packetBVHMaxTriangles (0: never):
-    // measured (quiet, AVX-512 and AVX2 builds, docs/benchmarks.md) its primary rays are
-    // 1.2-1.3x the wide packets' on the 100k-triangle dragon, while from 278k triangles
-    // on the wide packets win (primary 1.1-2.0x, shadow 1.5-2.5x) and skipping the binary
-    // build saves 30-40% of the build time.
-    size_t packetBVHMaxTriangles = 150'000;  // set before build()
+    // With the wide BVH the binary one is built only for meshes of at most
+    // packetBVHMaxTriangles (default 0: never). Measured in session 20 (Zen 5, AVX-512 and
+    // AVX2 builds, docs/benchmarks.md): the wide packets' primary rays are 1.03-1.29x
+    // Embree's on every real scan (0.73-1.03x the binary BVH's; it wins on the smallest
+    // meshes), their shadow rays 1.12-1.64x, and the wide build alone takes 0.62-0.80x
+    // Embree's time at 2 threads and 0.67-0.78x its memory, where building both took
+    // 1.6-1.9x its time and 1.4x its memory.
+    size_t packetBVHMaxTriangles = 0;  // set before build()
     MeshWideBVH wide;
     Tracer<WideBVHIntersector<TriangleIntersector>> wideTracer;
     Tracer<WideBVHPacketIntersector<TriangleIntersector>> widePacketTracer;
@@ -206,7 +208,7 @@ struct MeshScene {
     }
     // Shadow rays take the wide packets whenever the wide BVH exists: on the 100k dragon
     // too they were 1.07-1.21x the binary BVH's in every quiet run (session s6, AVX-512 and
-    // AVX2 builds, 1 and 2 threads), where primary rays keep the binary BVH.
+    // AVX2 builds, 1 and 2 threads).
     template <int N>
     Mask<N> occluded(const RayPacket<N>& rays, const Mask<N>& active) const {
         if (hasWide()) return widePacketTracer.occluded(wide, rays, active);

@@ -25,8 +25,8 @@ void MeshOptions::addTo(CLI::App& cmd) {
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
     cmd.add_option("--secondary", settings.secondary,
-                   "AO / path bounce rays: wide (single rays through a wide BVH), packet (the packet BVH) or auto "
-                   "(AO: packet, path: wide)")
+                   "AO / path bounce rays: wide (single rays through the wide BVH, whose packets trace every "
+                   "coherent ray), packet (every ray through a binary packet BVH instead) or auto (wide)")
         ->capture_default_str()
         ->check(CLI::IsMember({"auto", "wide", "packet"}));
 }

@@ -649,19 +649,20 @@ TEST(WideBVH, IntegratorsSameImageEitherStructure) {
     expectSameImage(ptImgP, ptImgW);
 }
 
-// Above packetBVHMaxTriangles the binary BVH is not built and coherent rays (camera and
-// shadow rays) take the wide BVH's packet traversal: the same picture.
-TEST(WideBVH, LargeMeshesTraceCoherentRaysThroughWidePackets) {
+// By default the binary BVH is not built and coherent rays (camera and shadow rays) take
+// the wide BVH's packet traversal; up to packetBVHMaxTriangles camera rays take the binary
+// packet BVH: the same picture.
+TEST(WideBVH, CoherentRaysTakeTheWidePacketsByDefault) {
     Mesh a = test::heightField(20, 4);
     a.append(test::uvSphere({0.2f, 0.5f, -0.1f}, 0.35f, 12));
     const auto m = std::make_shared<const Mesh>(a);
-    const MeshScene<BVH<Triangle>> small(m);  // far below the default threshold
+    MeshScene<BVH<Triangle>> small;
+    small.mesh = m;
+    small.packetBVHMaxTriangles = m->triangles();  // both BVHs
+    small.build();
     EXPECT_FALSE(small.coherentWide());
     EXPECT_FALSE(small.accel.nodes.empty());
-    MeshScene<BVH<Triangle>> large;
-    large.mesh = m;
-    large.packetBVHMaxTriangles = m->triangles() - 1;
-    large.build();
+    const MeshScene<BVH<Triangle>> large(m);  // the default: the wide BVH alone
     EXPECT_TRUE(large.coherentWide());
     EXPECT_TRUE(large.accel.nodes.empty());  // no binary build
     ASSERT_TRUE(large.hasWide());
