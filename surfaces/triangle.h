@@ -93,6 +93,27 @@ struct TriangleIntersector {
     template <HitData D, int L, int N>
     RTFACT_INLINE void intersectBlockChunk(const TriangleBlock<L>& b, int n, const RayPacket<N>& rays, Hit<N>& hit,
                                            int k) const {
+        if (rays.commonOrigin) {
+            // The block's edge vectors, normals and plane numerators in one SIMD pass (the
+            // values the per-triangle test computes one scalar triangle at a time, as
+            // intersectBlockLanes does), then each triangle's lane against the chunk.
+            using PL = Packet<L>;
+            const PL ox(rays.org.x[0]), oy(rays.org.y[0]), oz(rays.org.z[0]);
+            const Vec3<L> a(PL::load(b.v[0][0]) - ox, PL::load(b.v[0][1]) - oy, PL::load(b.v[0][2]) - oz);
+            const Vec3<L> bb(PL::load(b.v[1][0]) - ox, PL::load(b.v[1][1]) - oy, PL::load(b.v[1][2]) - oz);
+            const Vec3<L> c(PL::load(b.v[2][0]) - ox, PL::load(b.v[2][1]) - oy, PL::load(b.v[2][2]) - oz);
+            const Vec3<L> nn = blockNormal(b);
+            const Vec3<L> e[4] = {triangleEdge(bb, c), triangleEdge(c, a), triangleEdge(a, bb), nn};
+            alignas(64) float v[13][L];  // e0, e1, e2, n (x, y, z each), then tnum
+            for (int j = 0; j < 4; ++j)
+                for (int a3 = 0; a3 < 3; ++a3) e[j][a3].store(v[3 * j + a3]);
+            dot(nn, a).store(v[12]);
+            for (int i = 0; i < n; ++i)
+                commonOriginChunk<D>(Vec3f(v[0][i], v[1][i], v[2][i]), Vec3f(v[3][i], v[4][i], v[5][i]),
+                                     Vec3f(v[6][i], v[7][i], v[8][i]), Vec3f(v[9][i], v[10][i], v[11][i]), v[12][i],
+                                     uint32_t(b.id[i]), rays, hit, k, k + 1);
+            return;
+        }
         for (int i = 0; i < n; ++i) {
             const Triangle t{Vec3f(b.v[0][0][i], b.v[0][1][i], b.v[0][2][i]),
                              Vec3f(b.v[1][0][i], b.v[1][1][i], b.v[1][2][i]),
@@ -154,52 +175,69 @@ struct TriangleIntersector {
         return found;
     }
 
+    // Lanes of chunk k whose edge functions e0, e1, e2 agree and whose plane distance
+    // (plane() gives (tnum, nd), computed only once some lane is inside) lies in range
+    // take triangle id. The distance comes from the plane equation (tnum / dot(n, d)), not
+    // from the edge sum: edge functions of a small triangle far from the origin lose many
+    // bits.
+    template <HitData D, int N, int W, class Plane>
+    static RTFACT_INLINE void finishChunk(int k, const Packet<W>& e0, const Packet<W>& e1, const Packet<W>& e2,
+                                          const Plane& plane, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit) {
+        using P = Packet<W>;
+        using PI = Packet<W, int32_t>;
+        const auto inside = edgesAgree(e0, e1, e2);
+        if (none(inside)) return;
+        const auto [tnum, nd] = plane();
+        const P t = tnum / nd;
+        P& th = hit.t.chunk(k);
+        const auto m = inside & (nd != P(0.0f)) & (t > rays.tMin.chunk(k)) & (t < th);
+        if (none(m)) return;
+        th = select(m, t, th);
+        hit.id.chunk(k) = select(m, PI(int32_t(id)), hit.id.chunk(k));
+        if constexpr (D == HitData::Shading) {
+            const P inv = P(1.0f) / (e0 + e1 + e2);
+            hit.u.chunk(k) = select(m, e1 * inv, hit.u.chunk(k));
+            hit.v.chunk(k) = select(m, e2 * inv, hit.v.chunk(k));
+        }
+    }
+    // Chunks [firstChunk, endChunk) of a common-origin packet against one triangle given
+    // by its edge vectors, normal and plane numerator relative to the origin.
+    template <HitData D, int N>
+    static RTFACT_INLINE void commonOriginChunk(const Vec3f& e0f, const Vec3f& e1f, const Vec3f& e2f, const Vec3f& n,
+                                                float tnumf, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit,
+                                                int firstChunk, int endChunk) {
+        constexpr int W = Packet<N>::W;
+        using P = Packet<W>;
+        const Vec3<W> e0(e0f), e1(e1f), e2(e2f), nn(n);
+        const P tnum(tnumf);
+        for (int k = firstChunk; k < endChunk; ++k) {
+            const Vec3<W> d = rays.dir.chunk(k);
+            finishChunk<D>(
+                k, dot(e0, d), dot(e1, d), dot(e2, d), [&] { return std::pair<P, P>(tnum, dot(nn, d)); }, id, rays,
+                hit);
+        }
+    }
+
     // Chunks [firstChunk, endChunk) of the packet against one triangle.
     template <HitData D, int N>
     RTFACT_INLINE void intersectChunks(const Triangle& tri, uint32_t id, const RayPacket<N>& rays, Hit<N>& hit,
                                        int firstChunk, int endChunk) const {
         constexpr int W = Packet<N>::W;
         using P = Packet<W>;
-        using PI = Packet<W, int32_t>;
         const Vec3f n = faceNormal(tri.v0, tri.v1, tri.v2);
-        const P zero(0.0f);
-        // Lanes hit when the three edge functions agree in sign and t is in range. The
-        // distance comes from the plane equation (tnum / dot(n, d)), not from the edge
-        // sum: edge functions of a small triangle far from the origin lose many bits.
-        // plane() gives (tnum, nd), computed only once some lane is inside.
-        auto finish = [&](int k, const P& e0, const P& e1, const P& e2, const auto& plane)
-            __attribute__((always_inline)) {
-            const auto inside = edgesAgree(e0, e1, e2);
-            if (none(inside)) return;
-            const auto [tnum, nd] = plane();
-            const P t = tnum / nd;
-            P& th = hit.t.chunk(k);
-            const auto m = inside & (nd != zero) & (t > rays.tMin.chunk(k)) & (t < th);
-            if (none(m)) return;
-            th = select(m, t, th);
-            hit.id.chunk(k) = select(m, PI(int32_t(id)), hit.id.chunk(k));
-            if constexpr (D == HitData::Shading) {
-                const P inv = P(1.0f) / (e0 + e1 + e2);
-                hit.u.chunk(k) = select(m, e1 * inv, hit.u.chunk(k));
-                hit.v.chunk(k) = select(m, e2 * inv, hit.v.chunk(k));
-            }
-        };
         if (rays.commonOrigin) {
             const Vec3f o(rays.org.x[0], rays.org.y[0], rays.org.z[0]);
             const Vec3f a = tri.v0 - o, b = tri.v1 - o, c = tri.v2 - o;
-            const Vec3<W> e0(triangleEdge(b, c)), e1(triangleEdge(c, a)), e2(triangleEdge(a, b)), nn(n);
-            const P tnum(dot(n, a));
-            for (int k = firstChunk; k < endChunk; ++k) {
-                const Vec3<W> d = rays.dir.chunk(k);
-                finish(k, dot(e0, d), dot(e1, d), dot(e2, d), [&] { return std::pair<P, P>(tnum, dot(nn, d)); });
-            }
+            commonOriginChunk<D>(triangleEdge(b, c), triangleEdge(c, a), triangleEdge(a, b), n, dot(n, a), id, rays,
+                                 hit, firstChunk, endChunk);
         } else {
             const Vec3<W> v0(tri.v0), v1(tri.v1), v2(tri.v2), nn(n);
             for (int k = firstChunk; k < endChunk; ++k) {
                 const Vec3<W> o = rays.org.chunk(k), d = rays.dir.chunk(k);
                 const Vec3<W> a = v0 - o, b = v1 - o, c = v2 - o;
-                finish(k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d),
-                       [&] { return std::pair<P, P>(dot(nn, a), dot(nn, d)); });
+                finishChunk<D>(
+                    k, dot(triangleEdge(b, c), d), dot(triangleEdge(c, a), d), dot(triangleEdge(a, b), d),
+                    [&] { return std::pair<P, P>(dot(nn, a), dot(nn, d)); }, id, rays, hit);
             }
         }
     }
