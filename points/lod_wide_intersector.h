@@ -34,8 +34,10 @@ struct LoDWideIntersector {
     // Chunks reached by at most this fraction of their lanes (at least one) go on as single
     // rays; leaves reached by at most singleRayLeafFraction of them test their blocks
     // lane by lane (one SIMD test over a block's discs per ray), else disc by disc for the
-    // chunk's lanes at once.
-    float singleRayFraction = 0.25f;
+    // chunk's lanes at once. One eighth (one AVX2 lane, two AVX-512 ones) against a
+    // quarter: full detail on the 2M dragon +2-5% at 1 and 2 threads on both ISAs
+    // (session 20, alternating runs); the 32M LoD frames did not move.
+    float singleRayFraction = 0.125f;
     float singleRayLeafFraction = 0.5f;
 
     template <bool CommonOrigin, HitData D, int N>
