@@ -129,11 +129,11 @@ struct MeshScene {
     // shadow rays take the wide packets whenever the wide BVH exists (occluded()).
     // With the wide BVH the binary one is built only for meshes of at most
     // packetBVHMaxTriangles (default 0: never). Measured in session 20 (Zen 5, AVX-512 and
-    // AVX2 builds, docs/benchmarks.md): the wide packets' primary rays are 1.03-1.29x
-    // Embree's on every real scan (0.73-1.03x the binary BVH's; it wins on the smallest
-    // meshes), their shadow rays 1.12-1.64x, and the wide build alone takes 0.62-0.80x
-    // Embree's time at 2 threads and 0.67-0.78x its memory, where building both took
-    // 1.6-1.9x its time and 1.4x its memory.
+    // AVX2 builds, docs/benchmarks.md): the wide packets' primary rays are 1.13-1.37x
+    // Embree's on every real scan (0.80-1.10x the binary BVH's; it wins on the smallest
+    // meshes), their shadow rays 1.20-1.81x, and the wide build alone takes 0.56-0.84x
+    // Embree's time at 2 threads and 0.68-0.78x its memory, where building both took
+    // 1.5-2.1x its time and 1.4x its memory.
     size_t packetBVHMaxTriangles = 0;  // set before build()
     MeshWideBVH wide;
     Tracer<WideBVHIntersector<TriangleIntersector>> wideTracer;
