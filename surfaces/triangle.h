@@ -94,14 +94,11 @@ struct TriangleIntersector {
     RTFACT_INLINE void intersectBlockChunk(const TriangleBlock<L>& b, int n, const RayPacket<N>& rays, Hit<N>& hit,
                                            int k) const {
         if (rays.commonOrigin) {
-            // The block's edge vectors, normals and plane numerators in one SIMD pass (the
-            // values the per-triangle test computes one scalar triangle at a time, as
-            // intersectBlockLanes does), then each triangle's lane against the chunk.
-            using PL = Packet<L>;
-            const PL ox(rays.org.x[0]), oy(rays.org.y[0]), oz(rays.org.z[0]);
-            const Vec3<L> a(PL::load(b.v[0][0]) - ox, PL::load(b.v[0][1]) - oy, PL::load(b.v[0][2]) - oz);
-            const Vec3<L> bb(PL::load(b.v[1][0]) - ox, PL::load(b.v[1][1]) - oy, PL::load(b.v[1][2]) - oz);
-            const Vec3<L> c(PL::load(b.v[2][0]) - ox, PL::load(b.v[2][1]) - oy, PL::load(b.v[2][2]) - oz);
+            // The block's edge vectors, normals and plane numerators in one SIMD pass (as
+            // intersectBlockLanes computes them; the per-triangle test gets the same values
+            // one triangle at a time), then each triangle's lane against the chunk.
+            Vec3<L> a, bb, c;
+            blockRelative(b, Vec3f(rays.org.x[0], rays.org.y[0], rays.org.z[0]), a, bb, c);
             const Vec3<L> nn = blockNormal(b);
             const Vec3<L> e[4] = {triangleEdge(bb, c), triangleEdge(c, a), triangleEdge(a, bb), nn};
             alignas(64) float v[13][L];  // e0, e1, e2, n (x, y, z each), then tnum
@@ -152,23 +149,17 @@ struct TriangleIntersector {
             }
             found |= 1u << (i - k * W);
         };
-        auto rel = [&](const Vec3f& o, Vec3<L>& a, Vec3<L>& bb, Vec3<L>& c) __attribute__((always_inline)) {
-            const P ox(o.x), oy(o.y), oz(o.z);
-            a = Vec3<L>(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
-            bb = Vec3<L>(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
-            c = Vec3<L>(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
-        };
         const Vec3<L> nn = blockNormal(b);  // origin-free: once per block
         if (rays.commonOrigin) {
             Vec3<L> a, bb, c;
-            rel(Vec3f(rays.org.x[0], rays.org.y[0], rays.org.z[0]), a, bb, c);
+            blockRelative(b, Vec3f(rays.org.x[0], rays.org.y[0], rays.org.z[0]), a, bb, c);
             const Vec3<L> e0v = triangleEdge(bb, c), e1v = triangleEdge(c, a), e2v = triangleEdge(a, bb);
             for (uint32_t r = lanes; r; r &= r - 1) lane(k * W + __builtin_ctz(r), a, nn, e0v, e1v, e2v);
         } else {
             for (uint32_t r = lanes; r; r &= r - 1) {
                 const int i = k * W + __builtin_ctz(r);
                 Vec3<L> a, bb, c;
-                rel(Vec3f(rays.org.x[i], rays.org.y[i], rays.org.z[i]), a, bb, c);
+                blockRelative(b, Vec3f(rays.org.x[i], rays.org.y[i], rays.org.z[i]), a, bb, c);
                 lane(i, a, nn, triangleEdge(bb, c), triangleEdge(c, a), triangleEdge(a, bb));
             }
         }
@@ -370,15 +361,22 @@ struct TriangleIntersector {
         for (int j = 0; j < 3; ++j) w[j] = Vec3<L>(P::load(b.v[j][0]), P::load(b.v[j][1]), P::load(b.v[j][2]));
         return faceNormal(w[0], w[1], w[2]);
     }
+    // The vertices of a block's triangles relative to origin o, as loaded from the block.
+    template <int L>
+    static RTFACT_INLINE void blockRelative(const TriangleBlock<L>& b, const Vec3f& o, Vec3<L>& a, Vec3<L>& bb,
+                                            Vec3<L>& c) {
+        using P = Packet<L>;
+        const P ox(o.x), oy(o.y), oz(o.z);
+        a = Vec3<L>(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
+        bb = Vec3<L>(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
+        c = Vec3<L>(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
+    }
     template <int L>
     static RTFACT_INLINE auto blockTest(const TriangleBlock<L>& b, const RayPacket<1>& ray, float tFar, Packet<L>& e0,
                                         Packet<L>& e1, Packet<L>& e2, Packet<L>& t) {
-        using P = Packet<L>;
-        const P ox(ray.org.x[0]), oy(ray.org.y[0]), oz(ray.org.z[0]);
         const Vec3<L> d(Vec3f(ray.dir.x[0], ray.dir.y[0], ray.dir.z[0]));
-        const Vec3<L> a(P::load(b.v[0][0]) - ox, P::load(b.v[0][1]) - oy, P::load(b.v[0][2]) - oz);
-        const Vec3<L> bb(P::load(b.v[1][0]) - ox, P::load(b.v[1][1]) - oy, P::load(b.v[1][2]) - oz);
-        const Vec3<L> c(P::load(b.v[2][0]) - ox, P::load(b.v[2][1]) - oy, P::load(b.v[2][2]) - oz);
+        Vec3<L> a, bb, c;
+        blockRelative(b, Vec3f(ray.org.x[0], ray.org.y[0], ray.org.z[0]), a, bb, c);
         // The normal reloads the vertices (the barrier stops the compiler from keeping the
         // first loads live across the edge test, which spills them on AVX2).
         return laneTest(a, bb, c, d, float(ray.tMin), tFar, e0, e1, e2, t, [&] {
