@@ -3,6 +3,7 @@
 // radius, tMin < t < hit.t.
 #pragma once
 #include "core/concepts/intersector.h"
+#include "core/simd/chunk_group.h"
 #include "points/disc.h"
 
 namespace rtfact::points {
@@ -24,28 +25,33 @@ struct DiscIntersector {
     RTFACT_INLINE static void intersectDisc(Vec3f c, Vec3f n, float r2, int32_t id, const RayPacket<N>& rays,
                                             Hit<N>& hit, int firstChunk) {
         for (int k = firstChunk; k < Packet<N>::C; ++k)
-            intersectDiscChunk(c, n, r2, id, rays, hit, k, Mask<Packet<N>::W>(true));
+            intersectDiscGroup<Packet<N>::W>(c, n, r2, id, rays, hit, k, Mask<Packet<N>::W>(true));
     }
 
-    // Lanes `lanes` of native chunk k only (the LoD wide traversal's chunks).
-    template <int N>
-    RTFACT_INLINE static void intersectDiscChunk(Vec3f c, Vec3f n, float r2, int32_t id, const RayPacket<N>& rays,
-                                                 Hit<N>& hit, int k, const Mask<Packet<N>::W>& lanes) {
-        constexpr int W = Packet<N>::W;
-        using P = Packet<W>;
-        using PI = Packet<W, int32_t>;
-        const P ox = rays.org.x.chunk(k), oy = rays.org.y.chunk(k), oz = rays.org.z.chunk(k);
-        const P dx = rays.dir.x.chunk(k), dy = rays.dir.y.chunk(k), dz = rays.dir.z.chunk(k);
+    // Lanes `lanes` of native chunks k .. k + M / W - 1 of a packet only (M = W: chunk
+    // k), the LoD wide traversal's chunks and lane groups.
+    template <int M, int N>
+    RTFACT_INLINE static void intersectDiscGroup(Vec3f c, Vec3f n, float r2, int32_t id, const RayPacket<N>& rays,
+                                                 Hit<N>& hit, int k, const Mask<M>& lanes) {
+        using P = Packet<M>;
+        using PI = Packet<M, int32_t>;
+        const P& ox = chunkGroup<M>(rays.org.x, k);
+        const P& oy = chunkGroup<M>(rays.org.y, k);
+        const P& oz = chunkGroup<M>(rays.org.z, k);
+        const P& dx = chunkGroup<M>(rays.dir.x, k);
+        const P& dy = chunkGroup<M>(rays.dir.y, k);
+        const P& dz = chunkGroup<M>(rays.dir.z, k);
         const P cx = P(c.x) - ox, cy = P(c.y) - oy, cz = P(c.z) - oz;
         const P num = cx * P(n.x) + cy * P(n.y) + cz * P(n.z);
         const P den = dx * P(n.x) + dy * P(n.y) + dz * P(n.z);
         const P t = num / den;  // +-inf or NaN for parallel rays: every comparison below fails
         const P px = dx * t - cx, py = dy * t - cy, pz = dz * t - cz;
         const P dist2 = px * px + py * py + pz * pz;
-        P& th = hit.t.chunk(k);
-        const auto m = lanes & (dist2 <= P(r2)) & (t > rays.tMin.chunk(k)) & (t < th);
+        P& th = chunkGroup<M>(hit.t, k);
+        PI& hid = chunkGroup<M>(hit.id, k);
+        const auto m = lanes & (dist2 <= P(r2)) & (t > chunkGroup<M>(rays.tMin, k)) & (t < th);
         th = select(m, t, th);
-        hit.id.chunk(k) = select(m, PI(id), hit.id.chunk(k));
+        hid = select(m, PI(id), hid);
     }
 };
 static_assert(ElementIntersector<DiscIntersector, Disc>);

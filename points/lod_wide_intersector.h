@@ -6,8 +6,9 @@
 // SIMD disc test intersects the ray with the cut children's representatives (hit at
 // `repScale` of their covering radius, as the kd-tree's). The other children are visited
 // near to far. Quality 0 is full detail.
-// Packets go through the tree a native chunk of W rays at a time (traverseChunk): the
-// levels above the cut are then fetched once per chunk instead of once per ray, which
+// Packets go through the tree a native chunk of W rays at a time (traverseGroup; LoD
+// frames on ISAs narrower than 16 lanes take two or four chunks as one group of 16): the
+// levels above the cut are then fetched once per group instead of once per ray, which
 // is where single rays spend their time on large clouds (dependent misses ~15 levels
 // deep). The cut stays each ray's own (its footprint at its own entry into the child's
 // box), so a packet answers every ray as a single ray would (up to the visiting order of
@@ -39,6 +40,10 @@ struct LoDWideIntersector {
     // (session 20, alternating runs); the 32M LoD frames did not move.
     float singleRayFraction = 0.125f;
     float singleRayLeafFraction = 0.5f;
+    // LoD frames trace narrow chunks (AVX2 and SSE) in groups of this many lanes (4 x 4
+    // pixels): each node's frustum test, the stack and the cut decisions serve two AVX2
+    // chunks at once.
+    static constexpr int kGroupLanes = 16;
 
     template <bool CommonOrigin, HitData D, int N>
     void intersect(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, const Mask<N>& active) const {
@@ -228,17 +233,24 @@ struct LoDWideIntersector {
 
     template <bool CommonOrigin, HitData D, bool AnyHit, int N>
     void traceChunks(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit) const {
-        constexpr int W = Packet<N>::W;
+        constexpr int W = Packet<N>::W, GW = kGroupLanes <= N && W < kGroupLanes ? kGroupLanes : W;
         const BitMask<N> bits(hit.t > Packet<N>(-kInfinity));
-        for (int k = 0; k < Packet<N>::C; ++k)
-            if (const uint32_t lanes = bits.chunkBits(k)) {
-                traverseChunk<CommonOrigin, D, AnyHit>(bvh, rays, hit, k, lanes);
-                // The shading reads each hit disc next (a cache miss per pixel on large
-                // clouds): start those loads while the other chunks trace.
-                if constexpr (!AnyHit)
-                    for (int i = k * W; i < (k + 1) * W; ++i)
-                        if (const int32_t id = hit.id[i]; id >= 0) __builtin_prefetch(&bvh.elems[size_t(id)]);
-            }
+        auto run = [&]<int M>() __attribute__((always_inline)) {
+            for (int g = 0; g < N / M; ++g)
+                if (const uint32_t lanes =
+                        uint32_t((bits.w[(g * M) / 64] >> ((g * M) % 64)) & ((uint64_t(1) << M) - 1))) {
+                    traverseGroup<CommonOrigin, D, AnyHit, M>(bvh, rays, hit, g, lanes);
+                    // The shading reads each hit disc next (a cache miss per pixel on large
+                    // clouds): start those loads while the other groups trace.
+                    if constexpr (!AnyHit)
+                        for (int i = g * M; i < (g + 1) * M; ++i)
+                            if (const int32_t id = hit.id[i]; id >= 0) __builtin_prefetch(&bvh.elems[size_t(id)]);
+                }
+        };
+        if (GW > W && quality > 0.0f)
+            run.template operator()<GW>();
+        else
+            run.template operator()<W>();
     }
 
     // Packet lane i as a single ray from inner node `start`; the result goes back into hit.
@@ -267,18 +279,21 @@ struct LoDWideIntersector {
         return (PI(int32_t(bits)) & laneBit) != PI(0);
     }
 
-    // Chunk k (active lanes `lanes`) through the tree. Per node, one interval test culls
-    // the K children for the whole chunk (core WideFrustum), then each candidate is tested
-    // against the chunk's lanes; the lanes whose footprint at their entry covers the
-    // child's representative are answered by it (one disc test for those lanes), the
-    // others descend. Entries reached by few lanes continue as single rays.
-    template <bool CommonOrigin, HitData D, bool AnyHit, int N>
-    void traverseChunk(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, int k, uint32_t lanes) const {
-        constexpr int W = Packet<N>::W;
+    // Group k of W lanes (one native chunk, or W / Wn of them as one group; active lanes
+    // `lanes`) through the tree. Per node, one interval test culls the K children for the
+    // whole group (core WideFrustum), then each candidate is tested against the group's
+    // lanes; the lanes whose footprint at their entry covers the child's representative
+    // are answered by it (one disc test for those lanes), the others descend. Entries
+    // reached by few lanes continue as single rays (a fraction of a native chunk's lanes).
+    template <bool CommonOrigin, HitData D, bool AnyHit, int W, int N>
+    void traverseGroup(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit, int k, uint32_t lanes) const {
         static_assert(W <= 32, "lane masks are 32 bits");
         using PW = Packet<W>;
-        const int singleLanes = std::max(1, int(singleRayFraction * float(W)));
-        const int singleLeafLanes = std::max(1, int(singleRayLeafFraction * float(W)));
+        const int k0 = k * (W / Packet<N>::W);  // the group's first native chunk
+        PW& ht = chunkGroup<W>(hit.t, k0);
+        Packet<W, int32_t>& hid = chunkGroup<W>(hit.id, k0);
+        const int singleLanes = std::max(1, int(singleRayFraction * float(Packet<N>::W)));
+        const int singleLeafLanes = std::max(1, int(singleRayLeafFraction * float(Packet<N>::W)));
         if (__builtin_popcount(lanes) <= singleLanes) {
             for (uint32_t b = lanes; b; b &= b - 1) singleLane<D, AnyHit>(bvh, rays, hit, k * W + __builtin_ctz(b), 0);
             return;
@@ -286,13 +301,13 @@ struct LoDWideIntersector {
         uint32_t open = lanes;  // lanes still searching (any hit: without an occluder)
         PW org[3], inv[3];
         for (int a = 0; a < 3; ++a) {
-            inv[a] = rays.invDir[a].chunk(k);
-            org[a] = CommonOrigin ? PW(rays.org[a][0]) : rays.org[a].chunk(k);
+            inv[a] = chunkGroup<W>(rays.invDir[a], k0);
+            org[a] = CommonOrigin ? PW(rays.org[a][0]) : chunkGroup<W>(rays.org[a], k0);
         }
-        const PW& tMin = rays.tMin.chunk(k);
+        const PW& tMin = chunkGroup<W>(rays.tMin, k0);
         WideFrustum fr;
-        fr.template init<K, W>(org, inv, tMin, hit.t.chunk(k) > PW(-kInfinity), CommonOrigin);
-        fr.tMaxHi = hmax(hit.t.chunk(k));
+        fr.template init<K, W>(org, inv, tMin, ht > PW(-kInfinity), CommonOrigin);
+        fr.tMaxHi = hmax(ht);
         const bool uniform = fr.uniform;
         const bool lod = quality > 0.0f;
         const PW cutBase(0.5f * quality * cone.base), cutSlope(0.5f * quality * cone.slope);
@@ -300,7 +315,7 @@ struct LoDWideIntersector {
         // Slab test of the chunk's lanes against child c of the node with bounds f, up to
         // each lane's current hit; tn receives the entry distances.
         auto laneHits = [&](const float* f, int c, PW& tn) __attribute__((always_inline)) {
-            PW tf = hit.t.chunk(k);
+            PW tf = ht;
             tn = tMin;
             for (int a = 0; a < 3; ++a) {
                 const PW t0 = (PW(f[a * K + c]) - org[a]) * inv[a], t1 = (PW(f[3 * K + a * K + c]) - org[a]) * inv[a];
@@ -311,8 +326,8 @@ struct LoDWideIntersector {
         };
         // Any hit: lanes that found an occluder leave the traversal.
         auto retire = [&]() {
-            const Mask<W> found = hit.id.chunk(k) != Packet<W, int32_t>(-1);
-            hit.t.chunk(k) = select(found, PW(-kInfinity), hit.t.chunk(k));
+            const Mask<W> found = hid != Packet<W, int32_t>(-1);
+            ht = select(found, PW(-kInfinity), ht);
             open &= ~uint32_t(BitMask<W>(found).w[0]);
         };
         // An entry remembers its parent and slot, so its lanes are tested again against the
@@ -348,9 +363,9 @@ struct LoDWideIntersector {
                         // Most cut children are hit: their disc (colour) is read by the shading next.
                         __builtin_prefetch(&bvh.reps[size_t(node) * K + size_t(c)]);
                         const float rr = r.radius[c] * repScale;
-                        DiscIntersector::intersectDiscChunk(Vec3f(r.c[0][c], r.c[1][c], r.c[2][c]),
-                                                            Vec3f(r.n[0][c], r.n[1][c], r.n[2][c]), rr * rr,
-                                                            LoDWideBVH::repId(node, c), rays, hit, k, laneMask<W>(cut));
+                        DiscIntersector::intersectDiscGroup(
+                            Vec3f(r.c[0][c], r.c[1][c], r.c[2][c]), Vec3f(r.n[0][c], r.n[1][c], r.n[2][c]), rr * rr,
+                            LoDWideBVH::repId(node, c), rays, hit, k0, laneMask<W>(cut));
                         if constexpr (AnyHit) {
                             retire();
                             if (!open) return;
@@ -366,7 +381,7 @@ struct LoDWideIntersector {
                 } else {
                     // The interval entry bounds the lanes' entries from below: it orders the
                     // children without a horizontal minimum per child.
-                    e.dist = uniform ? entry[c] : hmin(select(tn <= hit.t.chunk(k), tn, inf));
+                    e.dist = uniform ? entry[c] : hmin(select(tn <= ht, tn, inf));
                     pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                 }
             }
@@ -411,16 +426,16 @@ struct LoDWideIntersector {
                         const auto& b = blocks[j];
                         const int cnt = std::min(kDiscLeafBlock, e.count - j * kDiscLeafBlock);
                         for (int i = 0; i < cnt; ++i)
-                            DiscIntersector::intersectDiscChunk(Vec3f(b.c[0][i], b.c[1][i], b.c[2][i]),
+                            DiscIntersector::intersectDiscGroup(Vec3f(b.c[0][i], b.c[1][i], b.c[2][i]),
                                                                 Vec3f(b.n[0][i], b.n[1][i], b.n[2][i]), b.r2[i],
-                                                                b.id[i], rays, hit, k, m);
+                                                                b.id[i], rays, hit, k0, m);
                     }
                 }
                 if constexpr (AnyHit) {
                     retire();
                     if (!open) return;
                 } else {
-                    fr.tMaxHi = hmax(hit.t.chunk(k));
+                    fr.tMaxHi = hmax(ht);
                 }
             }
         }

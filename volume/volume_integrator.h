@@ -10,6 +10,7 @@
 
 #include "core/concepts/integrator.h"
 #include "core/render/render_counters.h"
+#include "core/simd/chunk_group.h"
 #include "core/util/prefetch.h"
 #include "volume/volume_scene.h"
 #include "volume/voxel_gather.h"
@@ -47,9 +48,9 @@ struct VolumeIntegrator {
             for (int k = 0; k < C; k += GG) {
                 Vec3<GG * W> col;
                 Packet<GG * W> alpha, depth;
-                march<GG * W, L, M>(s, group<GG * W>(rays.org, k), group<GG * W>(rays.dir, k),
-                                    group<GG * W>(rays.tMin, k), group<GG * W>(rays.tMax, k), group<GG * W>(active, k),
-                                    col, alpha, depth, samples, skipped);
+                march<GG * W, L, M>(s, chunkGroup<GG * W>(rays.org, k), chunkGroup<GG * W>(rays.dir, k),
+                                    chunkGroup<GG * W>(rays.tMin, k), chunkGroup<GG * W>(rays.tMax, k),
+                                    chunkGroup<GG * W>(active, k), col, alpha, depth, samples, skipped);
                 for (int j = 0; j < GG; ++j) {
                     r.color.setChunk(k + j, col.chunk(j));
                     r.alpha.chunk(k + j) = alpha.chunk(j);
@@ -80,19 +81,6 @@ struct VolumeIntegrator {
         return r;
     }
 
-    // Native chunks k .. k + G/W - 1 of a packet, as one packet of G lanes.
-    template <int G, int N, class T>
-    static RTFACT_INLINE const Packet<G, T>& group(const Packet<N, T>& p, int k) {
-        return *reinterpret_cast<const Packet<G, T>*>(&p.c[k]);
-    }
-    template <int G, int N>
-    static RTFACT_INLINE const Mask<G>& group(const Mask<N>& m, int k) {
-        return *reinterpret_cast<const Mask<G>*>(&m.c[k]);
-    }
-    template <int G, int N>
-    static RTFACT_INLINE Vec3<G> group(const Vec3<N>& v, int k) {
-        return {group<G>(v.x, k), group<G>(v.y, k), group<G>(v.z, k)};
-    }
     // The brick grid index of brick coordinates b.
     template <int W, class Scene>
     static RTFACT_INLINE Packet<W, int32_t> brickId(const Scene& s, const Packet<W, int32_t> (&b)[3]) {

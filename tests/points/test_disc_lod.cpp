@@ -766,14 +766,14 @@ TEST_P(DiscWideBVHSplit, CoarseQualityAnswersWithRepresentatives) {
     }
 }
 
-// Packets go through the wide BVH a native chunk at a time, sharing the levels above the
-// cut, yet every ray keeps its own cut (its footprint at its own entry into a child's box):
-// lane for lane, a packet finds what the ray finds alone, nearest and any hit, full
-// detail and coarse cuts, common and distinct origins, partial packets. The one
-// legitimate difference: a representative disc may reach outside its child's box, so
-// which of two overlapping representatives is found first can depend on the visiting
-// order. A cut per chunk (one footprint for all its rays) would change which
-// representative answers far more lanes and fail here.
+// Packets go through the wide BVH a native chunk (LoD on AVX2: a group of 16 lanes) at
+// a time, sharing the levels above the cut, yet every ray keeps its own cut (its footprint
+// at its own entry into a child's box): lane for lane, a packet finds what the ray finds
+// alone, nearest and any hit, full detail and coarse cuts, common and distinct origins,
+// partial packets. The one legitimate difference: a representative disc may reach outside
+// its child's box, so which of two overlapping representatives is found first can depend
+// on the visiting order. A cut per chunk (one footprint for all its rays) would change
+// which representative answers far more lanes and fail here.
 struct PacketVsSingle {
     int lanes = 0, same = 0, repOnly = 0, reps = 0;
 };
@@ -819,6 +819,7 @@ TEST_P(DiscWideBVHSplit, PacketsAnswerAsSingleRays) {
         PacketVsSingle st;
         for (bool common : {true, false}) {
             checkPacketsAsSingleRays<simd::kNativeWidth>(scene, q, common, 73, st);
+            checkPacketsAsSingleRays<16>(scene, q, common, 76, st);  // the engine's point packets
             checkPacketsAsSingleRays<64>(scene, q, common, 74, st);
             checkPacketsAsSingleRays<256>(scene, q, common, 75, st);
         }
