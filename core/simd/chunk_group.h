@@ -9,6 +9,8 @@ namespace rtfact::simd {
 
 template <int M, int N, class T>
 concept ChunkGroupOf = M <= N&& M % Packet<N, T>::W == 0 && chunkWidth(M) == Packet<N, T>::W;
+static_assert(ChunkGroupOf<2 * kNativeWidth, 4 * kNativeWidth, float>);
+static_assert(!ChunkGroupOf<kNativeWidth, 1, float>);
 
 template <int M, int N, class T>
 requires ChunkGroupOf<M, N, T> RTFACT_INLINE Packet<M, T>
