@@ -236,9 +236,10 @@ struct LoDWideIntersector {
         constexpr int W = Packet<N>::W, GW = kGroupLanes <= N && W < kGroupLanes ? kGroupLanes : W;
         const BitMask<N> bits(hit.t > Packet<N>(-kInfinity));
         auto run = [&]<int M>() __attribute__((always_inline)) {
-            for (int g = 0; g < N / M; ++g)
-                if (const uint32_t lanes =
-                        uint32_t((bits.w[(g * M) / 64] >> ((g * M) % 64)) & ((uint64_t(1) << M) - 1))) {
+            for (int g = 0; g < N / M; ++g) {
+                uint32_t lanes = 0;  // the group's native chunks' bits side by side
+                for (int j = 0; j < M / W; ++j) lanes |= bits.chunkBits(g * (M / W) + j) << (j * W);
+                if (lanes) {
                     traverseGroup<CommonOrigin, D, AnyHit, M>(bvh, rays, hit, g, lanes);
                     // The shading reads each hit disc next (a cache miss per pixel on large
                     // clouds): start those loads while the other groups trace.
@@ -246,6 +247,7 @@ struct LoDWideIntersector {
                         for (int i = g * M; i < (g + 1) * M; ++i)
                             if (const int32_t id = hit.id[i]; id >= 0) __builtin_prefetch(&bvh.elems[size_t(id)]);
                 }
+            }
         };
         if (GW > W && quality > 0.0f)
             run.template operator()<GW>();
