@@ -289,12 +289,14 @@ struct EmbreeSide {
     double lastCpuMs = 0.0;      // the calling thread's CPU ms of the last build
     double lastProcessMs = 0.0;  // the process's CPU ms of the last build (all threads)
     // Returns build ms (buffer copy excluded: both sides start from the loaded mesh).
-    double build(const Mesh& m) {
+    // robust: RTC_SCENE_FLAG_ROBUST, Embree's watertight mode (its default test may miss
+    // at shared edges; RTfact's triangle tests are always watertight).
+    double build(const Mesh& m, bool robust = false) {
         if (scene) rtcReleaseScene(scene);
         gEmbreeBytes = 0;  // counts what this scene allocates
         scene = rtcNewScene(device);
         rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
-        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
+        rtcSetSceneFlags(scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_MEDIUM);
         auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -568,13 +570,19 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
     if (secSamples > 0) {
         const SecondaryRays sr = makeSecondary(base, setup, scene.bounds(), secSamples, N);
         std::printf("secondary_rays=%zu (%d per primary hit, AO length %.4g)\n", sr.size(), secSamples, sr.tMaxAO);
-        std::vector<float> outP(sr.size()), outW(sr.size()), outG(sr.size()), outE(sr.size());
+        std::vector<float> outP(sr.size()), outW(sr.size()), outG(sr.size()), outE(sr.size()), outR(sr.size());
         double embreeMrays[2][2] = {{0, 0}, {0, 0}};  // [thread count index][ao]
+        // Embree in its watertight mode as well: the like-for-like peer of RTfact's test.
+        EmbreeSide robust(setup, threadCounts.back());
+        {
+            tbb::task_arena arena(threadCounts.back());
+            arena.execute([&] { robust.build(mesh, true); });
+        }
         for (int ao = 1; ao >= 0; --ao) {
             const char* name = ao ? "ao_occluded" : "bounce_nearest";
             for (size_t ti = 0; ti < threadCounts.size(); ++ti) {
                 const int T = threadCounts[ti];
-                Result p, wd, wg, e;
+                Result p, wd, wg, e, er;
                 auto timeMode = [&](Result& res, const MeshScene<BVH<Triangle>>& sc, SecondaryMode m,
                                     std::vector<float>& out) {
                     res.ms = std::min(res.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
@@ -588,17 +596,20 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
                     e.ms = std::min(e.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
                                         embreeSecondary(em->scene, sr, b, en, ao, outE);
                                     }));
+                    er.ms = std::min(er.ms, timeRange(T, sr.size(), size_t(N) * 64, [&](size_t b, size_t en) {
+                                         embreeSecondary(robust.scene, sr, b, en, ao, outR);
+                                     }));
                 }
-                p.rays = wd.rays = wg.rays = e.rays = sr.size();
+                p.rays = wd.rays = wg.rays = e.rays = er.rays = sr.size();
                 embreeMrays[ti][ao] = e.mrays();
                 std::printf(
                     "threads=%d %s_mrays: rtfact_wide_single=%.2f rtfact_wide_group=%.2f rtfact_packet%d=%.2f "
-                    "embree_single=%.2f ratio_wide_vs_embree=%.3f ratio_group_vs_embree=%.3f "
-                    "ratio_wide_vs_packet=%.3f\n",
-                    T, name, wd.mrays(), wg.mrays(), N, p.mrays(), e.mrays(), wd.mrays() / e.mrays(),
-                    wg.mrays() / e.mrays(), wd.mrays() / p.mrays());
+                    "embree_single=%.2f embree_robust_single=%.2f ratio_wide_vs_embree=%.3f "
+                    "ratio_wide_vs_embree_robust=%.3f ratio_group_vs_embree=%.3f ratio_wide_vs_packet=%.3f\n",
+                    T, name, wd.mrays(), wg.mrays(), N, p.mrays(), e.mrays(), er.mrays(), wd.mrays() / e.mrays(),
+                    wd.mrays() / er.mrays(), wg.mrays() / e.mrays(), wd.mrays() / p.mrays());
             }
-            size_t diffPW = 0, diffWE = 0, diffWG = 0;
+            size_t diffPW = 0, diffWE = 0, diffWG = 0, diffWR = 0;
             for (size_t i = 0; i < sr.size(); ++i) {
                 const auto same = [&](float a, float b) {
                     return ao ? a == b
@@ -607,10 +618,13 @@ int run(const std::string& file, const Mesh& mesh, const Setup& setup, int w, in
                 };
                 diffPW += !same(outP[i], outW[i]);
                 diffWE += !same(outW[i], outE[i]);
+                diffWR += !same(outW[i], outR[i]);
                 diffWG += outW[i] != outG[i];  // the same traversal per ray: bit-exact
             }
-            std::printf("agreement_%s: packet_vs_wide_diff=%zu wide_vs_embree_diff=%zu wide_vs_group_diff=%zu\n", name,
-                        diffPW, diffWE, diffWG);
+            std::printf(
+                "agreement_%s: packet_vs_wide_diff=%zu wide_vs_embree_diff=%zu wide_vs_embree_robust_diff=%zu "
+                "wide_vs_group_diff=%zu\n",
+                name, diffPW, diffWE, diffWR, diffWG);
         }
         if (wideVariants) {
             wideVariant<8, 4>(mesh, sr, threadCounts, repeat, embreeMrays);
