@@ -217,7 +217,7 @@ struct VolumeIntegrator {
                float& skipped) const {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
-        const bool adaptive = (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) && s.settings.maxStepMultiple > 1;
+        const bool adaptive = (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) && s.longSteps;
         // Rays into index space; t stays the world distance.
         const Vec3<W> oi = (o - Vec3<W>(s.origin)) * Vec3<W>(s.invSpacing);
         const Vec3<W> di = d * Vec3<W>(s.invSpacing);

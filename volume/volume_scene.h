@@ -96,6 +96,14 @@ struct VolumeScene {
     std::vector<int32_t> subInfo;
     static constexpr int32_t kSkipBit = int32_t(0x80000000u), kPoolMask = (1 << 28) - 1, kMaxDistance = 16;
     static constexpr int32_t kSubScopeBit = 1 << 30;
+    // Whether the march takes long steps (opacity-adaptive steps, DVR and shaded): only when
+    // at least kMinLongStepShare of the sub-bricks the TF shows allow them. Below that, the
+    // march's per-sample check of the long step's room costs about what the samples it saves
+    // do (Zen 4, translucent ramp at step 1: the head CT (10% of them) and the bonsai (11%)
+    // 2-4% faster without, the tooth (25%) the same speed at 3.5 dB more PSNR; the phantom's
+    // faint TF (68%) a third faster with them). Below it the step bits are all 0.
+    static constexpr double kMinLongStepShare = 0.3;
+    bool longSteps = false;
     // Transfer-function tables for 1, 2 and 4 steps (tf.size entries each): r, g, b and
     // the opacity 1 - (1 - a)^m of table m as four halves per entry (half_float.h), so that
     // one 64-bit gather fetches an entry.
@@ -188,7 +196,14 @@ struct VolumeScene {
             }
         }
         subInfo.resize(ns);
-        const std::vector<int32_t> steps = stepBits(v, visible);
+        std::vector<int32_t> steps = stepBits(v, visible);
+        size_t shown = 0, stepping = 0;
+        for (size_t i = 0; i < ns; ++i) {
+            shown += visible[i];
+            stepping += steps[i] != 0;
+        }
+        longSteps = stepping > 0 && double(stepping) >= kMinLongStepShare * double(shown);
+        if (!longSteps) std::fill(steps.begin(), steps.end(), 0);
         const std::vector<int32_t> dist = emptyDistance();
         for (size_t i = 0; i < ns; ++i) {
             const size_t b = brickOctant(i).first;

@@ -424,6 +424,41 @@ TEST(VolumeAdaptiveSteps, SubBricksOfMixedBricksTakeLongSteps) {
         if (step == 1.0f) {
             EXPECT_EQ(na * 8, np * 5);
         }
+        VolumeRenderSettings rs;
+        rs.stepVoxels = step;
+        EXPECT_TRUE((VolumeScene<uint8_t>(g, table, rs).longSteps)) << "step " << step;  // half of them
+    }
+}
+
+// Where few of the shown sub-bricks allow long steps (below VolumeScene::kMinLongStepShare:
+// here the lower sub-bricks of the first of 8 bricks, 4 of 64), the march takes none: it is
+// the plain march, sample for sample.
+TEST(VolumeAdaptiveSteps, FewLongStepSubBricksMarchPlainly) {
+    VolumeGrid grid = makeSlab(9, 9, 65, 0, 64, 0);
+    const uint8_t steep[3] = {150, 200, 250};
+    for (int k = 0; k < 65; ++k)
+        for (int j = 0; j < 9; ++j)
+            for (int i = 0; i < 9; ++i) grid.bytes[grid.index(i, j, k)] = k <= 4 ? 50 : steep[k % 3];
+    const BrickedVolume g = brickVolume(grid);
+    TransferFunction tf;
+    tf.colors = {{0.0f, {1, 1, 1}}, {1.0f, {1, 1, 1}}};
+    tf.opacity = {{0.0f, 0.02f}, {0.4f, 0.02f}, {0.6f, 0.0f}, {1.0f, 0.2f}};
+    for (float step : {1.0f, 0.5f}) {
+        const TFTable table = buildTable(tf, {0, 255}, step);
+        VolumeRenderSettings rs;
+        rs.stepVoxels = step;
+        const VolumeScene<uint8_t> s(g, table, rs);
+        EXPECT_FALSE(s.longSteps) << "step " << step;
+        for (int32_t info : s.subInfo) {
+            if (info >= 0) {
+                EXPECT_EQ(info >> 28, 0) << "step " << step;
+            }
+        }
+        const auto [Ta, na] = marchTransmittance(g, table, step, 4);
+        const auto [Tp, np] = marchTransmittance(g, table, step, 1);
+        EXPECT_LT(Tp[0], 0.5f) << "step " << step;
+        EXPECT_EQ(na, np) << "step " << step;
+        EXPECT_EQ(Ta, Tp) << "step " << step;
     }
 }
 
