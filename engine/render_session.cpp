@@ -165,18 +165,16 @@ PassResult RenderSession::renderSamples(int n) {
             // The first pass moves to the sum; first_ becomes the pass buffer.
             sum_.assign(first_->rawRGBA(), first_->rawRGBA() + size_t(w) * size_t(h) * 4);
         }
-        // A new buffer is clear; otherwise each tile clears its pixels as it renders them
-        // (RenderOptions::clear), unless only some tiles are rendered here (nextTile): the
-        // others must hold zeros. The depth (for EDL) stays the minimum over the accumulated
-        // passes, as in one pass of all their samples: it is cleared until a pass of this
-        // camera has completed (a cancelled first pass leaves the old camera's depth in the
-        // tiles it did not reach).
+        // Each tile's first sample replaces its pixels (RenderOptions::clear); where only
+        // some tiles are rendered here (nextTile) the others must hold zeros, which a new
+        // buffer does. The depth (for EDL) stays the minimum over the accumulated passes, as
+        // in one pass of all their samples: it is cleared until a pass of this camera has
+        // completed (a cancelled first pass leaves the old camera's depth in the tiles it did
+        // not reach).
         using Clear = RenderOptions::Clear;
-        const Clear clear = resize ? Clear::None : samples_ == 0 ? Clear::ColorAndDepth : Clear::Color;
-        if (!opts_.nextTile)
-            ro.clear = clear;
-        else if (clear != Clear::None)
-            first_->clear(Region{0, 0, w, h}, clear == Clear::ColorAndDepth);
+        const Clear clear = samples_ == 0 ? Clear::ColorAndDepth : Clear::Color;
+        ro.clear = clear;
+        if (opts_.nextTile && !resize) first_->clear(Region{0, 0, w, h}, clear == Clear::ColorAndDepth);
         ro.firstSample = samples_;
     }
     ro.threads = opts_.threads;

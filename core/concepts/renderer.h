@@ -1,4 +1,6 @@
-// Renderer: renders a rectangular region of the image for a scene through a camera.
+// Renderer: renders a rectangular region of the image for a scene through a camera,
+// writing each pixel of the region once per sample (a framebuffer may take the first
+// sample's writes as its clear: RGBAFramebuffer::overwriteSample).
 #pragma once
 #include "core/concepts/camera.h"
 #include "core/concepts/framebuffer.h"

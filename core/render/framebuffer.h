@@ -2,9 +2,16 @@
 // progressive rendering is the sum divided by the sample count.
 #pragma once
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "core/concepts/framebuffer.h"
+#include "core/simd/bitmask.h"
+#include "core/util/aligned_allocator.h"
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace rtfact {
 
@@ -19,16 +26,73 @@ class RGBAFramebuffer {
 
     template <int N>
     void write(const PixelSample<N>& s, const Radiance<N>& r, const Mask<N>& valid) {
-        for (int i = 0; i < N; ++i) {
-            if (!valid[i]) continue;
+        const bool over = s.sample == overwriteSample_, overDepth = over && overwriteDepth_;
+        simd::BitMask<N> bits(valid);
+        int i = 0;
+#if defined(__SSE2__)
+        // Runs of 4 lanes on 4 consecutive pixels of a row (the renderers' packet blocks are
+        // at least 4 wide): one 4x4 transpose and 4 vector stores instead of 16 scalar
+        // read-modify-writes. At 1024^2 the scalar loop took 5% of a volume frame.
+        const __m128i step = _mm_setr_epi32(0, 1, 2, 3);
+        for (; i + 4 <= N; i += 4) {
+            if (((bits.w[i >> 6] >> (i & 63)) & 0xF) != 0xF) continue;
+            const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&s.px[i]));
+            const __m128i y = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&s.py[i]));
+            const __m128i row = _mm_and_si128(_mm_cmpeq_epi32(x, _mm_add_epi32(_mm_set1_epi32(s.px[i]), step)),
+                                              _mm_cmpeq_epi32(y, _mm_set1_epi32(s.py[i])));
+            if (_mm_movemask_epi8(row) != 0xFFFF) continue;
+            const size_t p = size_t(s.py[i]) * size_t(w_) + size_t(s.px[i]);
+            __m128 c0 = _mm_loadu_ps(&r.color.x[i]), c1 = _mm_loadu_ps(&r.color.y[i]);
+            __m128 c2 = _mm_loadu_ps(&r.color.z[i]), c3 = _mm_loadu_ps(&r.alpha[i]);
+            _MM_TRANSPOSE4_PS(c0, c1, c2, c3);  // now pixel k's RGBA in ck
+            float* d = &rgba_[p * 4];
+            if (!over) {
+                c0 = _mm_add_ps(c0, _mm_loadu_ps(d));
+                c1 = _mm_add_ps(c1, _mm_loadu_ps(d + 4));
+                c2 = _mm_add_ps(c2, _mm_loadu_ps(d + 8));
+                c3 = _mm_add_ps(c3, _mm_loadu_ps(d + 12));
+            }
+            _mm_storeu_ps(d, c0);
+            _mm_storeu_ps(d + 4, c1);
+            _mm_storeu_ps(d + 8, c2);
+            _mm_storeu_ps(d + 12, c3);
+            if (!depth_.empty()) {
+                const __m128 z = _mm_loadu_ps(&r.depth[i]);
+                _mm_storeu_ps(&depth_[p], overDepth ? z : _mm_min_ps(z, _mm_loadu_ps(&depth_[p])));
+            }
+            bits.w[i >> 6] &= ~(uint64_t(0xF) << (i & 63));  // done
+        }
+#endif
+        for (i = 0; i < N; ++i) {
+            if (!bits[i]) continue;
             const size_t p = size_t(s.py[i]) * size_t(w_) + size_t(s.px[i]);
             float* d = &rgba_[p * 4];
-            d[0] += r.color.x[i];
-            d[1] += r.color.y[i];
-            d[2] += r.color.z[i];
-            d[3] += r.alpha[i];
-            if (!depth_.empty()) depth_[p] = std::min(depth_[p], float(r.depth[i]));
+            const float c[4] = {r.color.x[i], r.color.y[i], r.color.z[i], r.alpha[i]};
+            for (int k = 0; k < 4; ++k) d[k] = over ? c[k] : d[k] + c[k];
+            if (!depth_.empty()) depth_[p] = overDepth ? float(r.depth[i]) : std::min(depth_[p], float(r.depth[i]));
         }
+    }
+
+    // Asks for the pixels of s (one cache line per run of 4 from x % 4 == 0) ahead of their
+    // write, for writing: the renderer calls it before the integrator, so that the line
+    // reads of a framebuffer larger than the caches overlap its work (at 1024^2 a volume
+    // frame's stores otherwise waited on them: 5% of the frame).
+    template <int N>
+    void prefetch(const PixelSample<N>& s) const {
+        // Lanes outside the image ask for lines outside it: prefetches do not fault. (GCC 12
+        // drops the whole loop when the index is clamped, or a second loop prefetches the
+        // depth: check the generated code before changing it.)
+        const size_t w = size_t(w_);
+        for (int i = 0; i < N; i += 4)
+            __builtin_prefetch(rgba_.data() + (size_t(s.py[i]) * w + size_t(s.px[i])) * 4, 1, 3);
+    }
+
+    // From now on, writes of sample `sample` replace their pixels' colour (and their depth
+    // when depthToo) instead of adding to it, so that a pass whose renderer writes each
+    // pixel once per sample needs no clearing (RenderOptions::clear); -1: every write adds.
+    void overwriteSample(int sample, bool depthToo) {
+        overwriteSample_ = sample;
+        overwriteDepth_ = depthToo;
     }
 
     // Averaged pixel i (RGBA) after `samples` accumulated samples.
@@ -54,7 +118,9 @@ class RGBAFramebuffer {
 
    private:
     int w_, h_;
-    std::vector<float> rgba_;
+    int overwriteSample_ = -1;
+    bool overwriteDepth_ = false;
+    std::vector<float, AlignedAllocator<float, 64>> rgba_;  // a 4-pixel run from x % 4 == 0: one line
     std::vector<float> depth_;
 };
 static_assert(Framebuffer<RGBAFramebuffer>);

@@ -39,6 +39,7 @@ struct RayTracingRenderer {
                 sampler.template offsets<N>(s.px, s.py, sample, ox, oy);
                 RayPacket<N> rays;
                 cam.template generate<N>(toFloat(s.px) + ox, toFloat(s.py) + oy, rays);
+                if constexpr (requires { fb.template prefetch<N>(s); }) fb.template prefetch<N>(s);
                 const Radiance<N> r = integrator.template eval<N>(scene, rays, valid, s);
                 fb.template write<N>(s, r, valid);
             }

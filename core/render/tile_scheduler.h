@@ -27,8 +27,10 @@ struct RenderOptions {
     int firstSample = 0;  // samples firstSample .. firstSample + spp - 1 (progressive passes)
     // What of the framebuffer each tile clears before its first sample (the framebuffer
     // accumulates): done by the thread that renders the tile, while its pixels are about to be
-    // written, instead of one serial pass over the image before the render (16 MB at 1024^2).
-    // Tiles not rendered (cancelled, or not handed out by nextTile) are not cleared.
+    // written, instead of one serial pass over the image before the render (16 MB at 1024^2);
+    // a framebuffer with overwriteSample (RGBAFramebuffer) is not cleared at all, its first
+    // sample's writes replace the pixels. Tiles not rendered (cancelled, or not handed out by
+    // nextTile) are not cleared.
     enum class Clear { None, Color, ColorAndDepth } clear = Clear::None;
     // Set from any thread: no tile starts once it is true (a render stops within one tile
     // per thread); the stats then say cancelled.
@@ -83,8 +85,14 @@ requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, 
     Progress progress(opt.label, uint64_t(tiles) * uint64_t(spp), opt.progress);
     const auto t0 = std::chrono::steady_clock::now();
     // One tile with every sample of this frame (the nextTile source) or one sample.
+    // A framebuffer that can overwrite (RGBAFramebuffer) takes the first sample's writes as
+    // the clear: the renderers write each pixel of their region once per sample.
+    constexpr bool overwrites = requires { fb.overwriteSample(0, true); };
+    const bool clearing = opt.clear != RenderOptions::Clear::None;
+    if constexpr (overwrites)
+        fb.overwriteSample(clearing ? opt.firstSample : -1, opt.clear == RenderOptions::Clear::ColorAndDepth);
     auto renderTile = [&](int t, int s) {
-        if (s == opt.firstSample && opt.clear != RenderOptions::Clear::None)
+        if (!overwrites && s == opt.firstSample && clearing)
             fb.clear(grid.region(t), opt.clear == RenderOptions::Clear::ColorAndDepth);
         renderer.template render<N>(scene, cam, fb, grid.region(t), s);
         progress.add();
@@ -119,6 +127,7 @@ requires Renderer<R, Scene, Cam, FB> RenderStats renderImage(const R& renderer, 
                 tbb::simple_partitioner());
         }
     });
+    if constexpr (overwrites) fb.overwriteSample(-1, false);
     progress.finish();
     st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     for (const RenderCounters& c : counted) st.counters += c;

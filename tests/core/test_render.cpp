@@ -113,6 +113,58 @@ TEST(Render, TilesClearTheirPixelsBeforeTheFirstSample) {
         }
 }
 
+// RGBAFramebuffer::write against per-pixel sums: runs of 4 lanes on 4 consecutive pixels
+// of a row take the vector path, the rest (a run with an invalid lane, permuted lanes, a
+// run across two rows) the scalar one; writes of the overwrite sample replace the pixels.
+template <int N>
+void checkFramebufferWrites() {
+    constexpr int w = 15, h = 9;  // every lane its own pixel
+    RGBAFramebuffer fb(w, h, true);
+    std::vector<float> rgba(size_t(w) * h * 4, 0.0f), depth(size_t(w) * h, kInfinity);
+    uint32_t seed = 7;
+    auto rnd = [&] { return float((seed = seed * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+    for (int pass = 0; pass < 3; ++pass) {
+        const int sample = pass == 0 ? 5 : pass == 1 ? 0 : 1;  // pass 1 overwrites
+        fb.overwriteSample(pass >= 1 ? 0 : -1, true);
+        PixelSample<N> s;
+        s.sample = sample;
+        Radiance<N> r;
+        Mask<N> valid(false);
+        for (int i = 0; i < N; ++i) {
+            const int run = (i / 4) % 4, k = i % 4, y = 2 * (i / 16);
+            int x = 0, yy = y;
+            if (run == 0) x = 1 + k;   // a row: vector
+            if (run == 1) x = 5 + k;   // a row, lane 2 invalid: scalar
+            if (run == 2) x = 12 - k;  // permuted: scalar
+            if (run == 3) {            // across two rows: scalar
+                x = 13 + k % 2;
+                yy = y + k / 2;
+            }
+            s.px[i] = x;
+            s.py[i] = yy;
+            valid.set(i, !(run == 1 && k == 2) && (pass != 0 || i % 3 != 0));
+            r.color.x[i] = rnd(), r.color.y[i] = rnd(), r.color.z[i] = rnd(), r.alpha[i] = rnd();
+            r.depth[i] = rnd();
+        }
+        fb.template write<N>(s, r, valid);
+        for (int i = 0; i < N; ++i) {
+            if (!valid[i]) continue;
+            const size_t p = size_t(s.py[i]) * w + size_t(s.px[i]);
+            const float c[4] = {r.color.x[i], r.color.y[i], r.color.z[i], r.alpha[i]};
+            for (int k = 0; k < 4; ++k) rgba[p * 4 + k] = pass == 1 ? c[k] : rgba[p * 4 + k] + c[k];
+            depth[p] = pass == 1 ? float(r.depth[i]) : std::min(depth[p], float(r.depth[i]));
+        }
+        EXPECT_EQ(fb.resolved(1), rgba) << "N " << N << " pass " << pass;
+        EXPECT_EQ(fb.depth(), depth) << "N " << N << " pass " << pass;
+    }
+}
+
+TEST(Render, FramebufferWritesMatchPerPixelSums) {
+    checkFramebufferWrites<1>();
+    checkFramebufferWrites<16>();
+    checkFramebufferWrites<64>();
+}
+
 TEST(Render, PacketBlockShapes) {
     EXPECT_EQ(packetBlockWidth(1), 1);
     EXPECT_EQ(packetBlockWidth(4), 2);
