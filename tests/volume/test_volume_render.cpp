@@ -396,6 +396,27 @@ TEST(VolumeAdaptiveSteps, VaryingOpacityMarchesPlainly) {
     }
 }
 
+namespace {
+
+// A 9 x 9 x 65 slab whose voxel layer k holds value(k), and the TF of the sub-brick tests:
+// faint (0.02) up to 40% of the range, hidden at 60%, ramping to 0.2 at the top.
+template <class F>
+BrickedVolume layeredSlab(F value) {
+    VolumeGrid grid = makeSlab(9, 9, 65, 0, 64, 0);
+    for (int k = 0; k < 65; ++k)
+        for (int j = 0; j < 9; ++j)
+            for (int i = 0; i < 9; ++i) grid.bytes[grid.index(i, j, k)] = uint8_t(value(k));
+    return brickVolume(grid);
+}
+TransferFunction faintAndSteepTF() {
+    TransferFunction tf;
+    tf.colors = {{0.0f, {1, 1, 1}}, {1.0f, {1, 1, 1}}};
+    tf.opacity = {{0.0f, 0.02f}, {0.4f, 0.02f}, {0.6f, 0.0f}, {1.0f, 0.2f}};
+    return tf;
+}
+
+}  // namespace
+
 // A brick whose value range is too wide for long steps may hold sub-bricks whose own range
 // allows them: along z, every brick is homogeneous (value 50, opacity 0.02) in its voxel
 // layers 0-4, the lower sub-brick, and steep (values 150 / 200 / 250 under an opacity ramp
@@ -404,15 +425,8 @@ TEST(VolumeAdaptiveSteps, VaryingOpacityMarchesPlainly) {
 // march plainly, and the transmittance stays that of the plain march: the homogeneous long
 // steps are exact up to the half-float opacity tables (|log T| within 2e-3).
 TEST(VolumeAdaptiveSteps, SubBricksOfMixedBricksTakeLongSteps) {
-    VolumeGrid grid = makeSlab(9, 9, 65, 0, 64, 0);
-    const uint8_t steep[3] = {150, 200, 250};
-    for (int k = 0; k < 65; ++k)
-        for (int j = 0; j < 9; ++j)
-            for (int i = 0; i < 9; ++i) grid.bytes[grid.index(i, j, k)] = k % 8 <= 4 ? 50 : steep[k % 8 - 5];
-    const BrickedVolume g = brickVolume(grid);
-    TransferFunction tf;
-    tf.colors = {{0.0f, {1, 1, 1}}, {1.0f, {1, 1, 1}}};
-    tf.opacity = {{0.0f, 0.02f}, {0.4f, 0.02f}, {0.6f, 0.0f}, {1.0f, 0.2f}};
+    const BrickedVolume g = layeredSlab([](int k) { return k % 8 <= 4 ? 50 : 150 + 50 * (k % 8 - 5); });
+    const TransferFunction tf = faintAndSteepTF();
     for (float step : {1.0f, 0.5f}) {
         const TFTable table = buildTable(tf, {0, 255}, step);
         const auto [Ta, na] = marchTransmittance(g, table, step, 4);
@@ -434,15 +448,8 @@ TEST(VolumeAdaptiveSteps, SubBricksOfMixedBricksTakeLongSteps) {
 // here the lower sub-bricks of the first of 8 bricks, 4 of 64), the march takes none: it is
 // the plain march, sample for sample.
 TEST(VolumeAdaptiveSteps, FewLongStepSubBricksMarchPlainly) {
-    VolumeGrid grid = makeSlab(9, 9, 65, 0, 64, 0);
-    const uint8_t steep[3] = {150, 200, 250};
-    for (int k = 0; k < 65; ++k)
-        for (int j = 0; j < 9; ++j)
-            for (int i = 0; i < 9; ++i) grid.bytes[grid.index(i, j, k)] = k <= 4 ? 50 : steep[k % 3];
-    const BrickedVolume g = brickVolume(grid);
-    TransferFunction tf;
-    tf.colors = {{0.0f, {1, 1, 1}}, {1.0f, {1, 1, 1}}};
-    tf.opacity = {{0.0f, 0.02f}, {0.4f, 0.02f}, {0.6f, 0.0f}, {1.0f, 0.2f}};
+    const BrickedVolume g = layeredSlab([](int k) { return k <= 4 ? 50 : 150 + 50 * (k % 3); });
+    const TransferFunction tf = faintAndSteepTF();
     for (float step : {1.0f, 0.5f}) {
         const TFTable table = buildTable(tf, {0, 255}, step);
         VolumeRenderSettings rs;
