@@ -62,7 +62,7 @@ void BrickBuilder::finish(BrickedVolume& v) {
         v.pool.resize(v.pool.size() + 64, 0);
         v.pool.shrink_to_fit();
     }
-    buildPairs(v);
+    buildMarchCopy(v);
 }
 
 namespace {
@@ -84,27 +84,58 @@ void fillPairs(BrickedVolume& v) {
                 }
     });
 }
+
+// y-z quads of u8 samples (BrickedVolume::quads)
+void fillQuads(BrickedVolume& v) {
+    using BV = BrickedVolume;
+    const size_t bricks = v.pool.size() / size_t(BV::kBrick);
+    const uint8_t* src = v.pool.data();
+    uint8_t* dst = v.quads.data();
+    tbb::parallel_for(size_t(0), bricks, [&](size_t b) {
+        const uint8_t* s = src + b * size_t(BV::kBrick);
+        uint8_t* d = dst + b * size_t(BV::kQuadEntries) * 4;
+        for (int z = 0; z < BV::kCells; ++z)
+            for (int y = 0; y < BV::kCells; ++y)
+                for (int x = 0; x < BV::kEdge; ++x) {
+                    const size_t e = size_t(x + y * BV::kQuadRow + z * BV::kQuadSlice) * 4;
+                    const uint8_t* c = s + x + y * BV::kEdge + z * BV::kEdge * BV::kEdge;
+                    d[e] = c[0];
+                    d[e + 1] = c[BV::kEdge];
+                    d[e + 2] = c[BV::kEdge * BV::kEdge];
+                    d[e + 3] = c[BV::kEdge + BV::kEdge * BV::kEdge];
+                }
+    });
+}
 }  // namespace
 
-bool buildPairs(BrickedVolume& v) {
-    v.pairs.clear();
-    v.pairs.shrink_to_fit();
+bool buildMarchCopy(BrickedVolume& v, bool allowQuads) {
+    using BV = BrickedVolume;
+    for (auto* copy : {&v.pairs, &v.quads}) {
+        copy->clear();
+        copy->shrink_to_fit();
+    }
     if (v.storage == Storage::F32) return false;
     const size_t bytes = size_t(storageBytes(v.storage));
-    const size_t bricks = v.pool.size() / (size_t(BrickedVolume::kBrick) * bytes);
-    const uint64_t need = uint64_t(bricks) * uint64_t(BrickedVolume::kPairEntries) * 2 * bytes + 64;
-    // Entries are addressed with 32-bit indices, like the pool's samples.
-    if (uint64_t(bricks) * uint64_t(BrickedVolume::kPairEntries) > uint64_t(std::numeric_limits<int32_t>::max()) - 64)
-        return false;
+    const size_t bricks = v.pool.size() / (size_t(BV::kBrick) * bytes);
     // Only while the copy stays cache-sized: measured (session s6, both ISAs) faster on the
     // head CT (2 MB of pairs) but slower on the bonsai (42 MB) and the 512^3 phantom
     // (183 MB), where the march waits on cache misses and the larger copy adds to them.
-    constexpr uint64_t kMaxPairBytes = uint64_t(16) << 20;
-    if (need > kMaxPairBytes) return false;
     // Optional: keep a quarter of what is available for everything else (frame buffers, a
-    // second scene), else render from the pool alone.
-    if (need > availableMemoryBytes() / 4 * 3) return false;
-    v.pairs.assign(need, 0);
+    // second scene), else render from the pool alone. Entries are addressed with 32-bit
+    // indices, like the pool's samples.
+    constexpr uint64_t kMaxCopyBytes = uint64_t(16) << 20;
+    const auto fits = [&](int entries, size_t entryBytes) {
+        const uint64_t need = uint64_t(bricks) * uint64_t(entries) * entryBytes + 64;
+        return uint64_t(bricks) * uint64_t(entries) <= uint64_t(std::numeric_limits<int32_t>::max()) - 64 &&
+               need <= kMaxCopyBytes && need <= availableMemoryBytes() / 4 * 3;
+    };
+    if (v.storage == Storage::U8 && allowQuads && fits(BV::kQuadEntries, 4)) {
+        v.quads.assign(size_t(bricks) * BV::kQuadEntries * 4 + 64, 0);
+        fillQuads(v);
+        return true;
+    }
+    if (!fits(BV::kPairEntries, 2 * bytes)) return false;
+    v.pairs.assign(size_t(bricks) * BV::kPairEntries * 2 * bytes + 64, 0);
     if (v.storage == Storage::U8)
         fillPairs<uint8_t>(v);
     else

@@ -37,15 +37,22 @@ struct BrickedVolume {
     // empty-space skipping. setBrickRanges fills both from a brick's samples.
     static constexpr int kSubCells = kCells / 2;
     std::vector<float> subLo, subHi;
-    // u8/u16 only, a second copy of the pool for the march: y-pair rows. Pool brick b is
-    // pair brick b of kPairEntries entries; entry (x, y, z), y < kCells, holds the samples
-    // (x, y, z) and (x, y + 1, z), so one 32-bit (u8) or 64-bit (u16) load at (x, y, z)
-    // returns the four corners of a cell face: a trilinear sample is 2 gathers, not 4.
+    // u8/u16 only, a second copy of the pool for the march, in one of two layouts (at most
+    // one is built; buildMarchCopy):
+    //  - y-z quads (u8): pool brick b is quad brick b of kQuadEntries entries of 4 samples;
+    //    entry (x, y, z), y, z < kCells, holds (x, y, z), (x, y + 1, z), (x, y, z + 1) and
+    //    (x, y + 1, z + 1), so one 64-bit load at (x, y, z) returns the cell's eight corners:
+    //    a trilinear sample is one gather (3.2x the pool's bytes).
+    //  - y-pairs (u8/u16): pool brick b is pair brick b of kPairEntries entries; entry
+    //    (x, y, z), y < kCells, holds the samples (x, y, z) and (x, y + 1, z), so one 32-bit
+    //    (u8) or 64-bit (u16) load at (x, y, z) returns the four corners of a cell face: a
+    //    trilinear sample is 2 gathers, not 4 (1.78x the pool).
     // Built only while it stays cache-sized (<= 16 MB: faster there, slower on large
     // volumes, where the march waits on cache misses) and the memory budget allows it;
-    // empty otherwise, and the march reads the pool.
+    // both empty otherwise, and the march reads the pool.
     static constexpr int kPairRow = kEdge, kPairSlice = kEdge * kCells, kPairEntries = kPairSlice * kEdge;
-    std::vector<uint8_t> pairs;
+    static constexpr int kQuadRow = kEdge, kQuadSlice = kEdge * kCells, kQuadEntries = kQuadSlice * kCells;
+    std::vector<uint8_t> pairs, quads;
 
     size_t brickCount() const { return size_t(nb[0]) * size_t(nb[1]) * size_t(nb[2]); }
     size_t brickIndex(int bx, int by, int bz) const {
@@ -55,7 +62,7 @@ struct BrickedVolume {
     // non-empty bricks (brick 0, the shared zero brick, not counted)
     size_t storedBricks() const { return pool.size() / (size_t(kBrick) * size_t(storageBytes(storage))) - 1; }
     size_t memoryBytes() const {
-        return pool.capacity() + pairs.capacity() + brickStart.capacity() * 4 +
+        return pool.capacity() + pairs.capacity() + quads.capacity() + brickStart.capacity() * 4 +
                (cellLo.capacity() + cellHi.capacity() + subLo.capacity() + subHi.capacity()) * 4;
     }
     template <class T>
@@ -85,7 +92,7 @@ struct BrickBuilder {
     // Appends a brick filled by fill(i, j, k) -> stored value for local samples.
     template <class F>
     static void addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill);
-    // Checks the offsets, pads the pool and builds the y-pair copy (buildPairs).
+    // Checks the offsets, pads the pool and builds the march's copy (buildMarchCopy).
     static void finish(BrickedVolume& v);
 };
 
@@ -114,10 +121,11 @@ void setBrickRanges(BrickedVolume& v, size_t b, const T* s) {
     v.cellHi[b] = hi;
 }
 
-// Builds v.pairs from v.pool for u8/u16 volumes when the copy (1.78x the pool) is at most
-// 16 MB and the memory budget allows it (core/util/memory_budget.h), else leaves it
-// empty. Returns whether built.
-bool buildPairs(BrickedVolume& v);
+// Builds the march's copy of v.pool for u8/u16 volumes (y-z quads for u8, y-pairs for u16
+// or where the quads would not fit) when it is at most 16 MB and the memory budget allows
+// it (core/util/memory_budget.h), else leaves both empty. Returns whether one was built.
+// allowQuads = false builds y-pairs for u8 too (tests compare the layouts).
+bool buildMarchCopy(BrickedVolume& v, bool allowQuads = true);
 
 template <class F>
 void BrickBuilder::addBrick(BrickedVolume& v, int bx, int by, int bz, F&& fill) {

@@ -22,9 +22,12 @@ struct VolumeIntegrator {
 
     template <int N, class Scene>
     Radiance<N> eval(const Scene& s, RayPacket<N>& rays, const Mask<N>& active, const PixelSample<N>&) const {
-        // The voxel layout, once per packet: y-pairs when the volume has them.
-        if constexpr (sizeof(typename Scene::Voxel) < 4)
-            if (s.pairVoxels) return evalIn<VoxelLayout::YPairs, N>(s, rays, active);
+        // The voxel layout, once per packet: the march's copy when the volume has one.
+        if constexpr (sizeof(typename Scene::Voxel) < 4) {
+            if constexpr (sizeof(typename Scene::Voxel) == 1)
+                if (s.copyLayout == VoxelLayout::YZQuads) return evalIn<VoxelLayout::YZQuads, N>(s, rays, active);
+            if (s.copyLayout == VoxelLayout::YPairs) return evalIn<VoxelLayout::YPairs, N>(s, rays, active);
+        }
         return evalIn<VoxelLayout::Rows, N>(s, rays, active);
     }
 
@@ -110,14 +113,17 @@ struct VolumeIntegrator {
                                               const Packet<W, int32_t>& start) {
         using P = Packet<W>;
         using I = Packet<W, int32_t>;
+        static_assert(L != VoxelLayout::YZQuads || sizeof(typename Scene::Voxel) == 1, "y-z quads are u8");
         constexpr int R = Scene::template kRowStride<L>, S = Scene::template kSliceStride<L>;
         const P fx = p.x - toFloat(cell[0]), fy = p.y - toFloat(cell[1]), fz = p.z - toFloat(cell[2]);
         const I base = start + cellInBrick<W, R, S>(cell);
         // rows (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1): a = x, b = x + 1
         P a0, b0, a1, b1, a2, b2, a3, b3;
-        if constexpr (L == VoxelLayout::YPairs) {
-            fetchQuad<typename Scene::Voxel, W>(s.pairVoxels, base, a0, a1, b0, b1);
-            fetchQuad<typename Scene::Voxel, W>(s.pairVoxels, base + I(S), a2, a3, b2, b3);
+        if constexpr (L == VoxelLayout::YZQuads) {
+            fetchCube<W>(reinterpret_cast<const uint8_t*>(s.copyVoxels), base, a0, a1, a2, a3, b0, b1, b2, b3);
+        } else if constexpr (L == VoxelLayout::YPairs) {
+            fetchQuad<typename Scene::Voxel, W>(s.copyVoxels, base, a0, a1, b0, b1);
+            fetchQuad<typename Scene::Voxel, W>(s.copyVoxels, base + I(S), a2, a3, b2, b3);
         } else {
             fetchPair<typename Scene::Voxel, W>(s.voxels, base, a0, b0);
             fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(R), a1, b1);

@@ -44,29 +44,39 @@ struct VolumeRenderSettings {
 // Where the march reads voxels from. Chosen once per packet march (VolumeIntegrator::
 // eval), a closed list of template arguments, so the sampling code has no per-sample test.
 enum class VoxelLayout {
-    Rows,    // the brick pool: x-rows of kEdge samples
-    YPairs,  // BrickedVolume::pairs (u8/u16): entries of two y-neighbours
+    Rows,     // the brick pool: x-rows of kEdge samples
+    YPairs,   // BrickedVolume::pairs (u8/u16): entries of two y-neighbours
+    YZQuads,  // BrickedVolume::quads (u8): entries of a y-z square of four samples
 };
 
 template <class T>
 struct VolumeScene {
     using Voxel = T;
     static constexpr int kCells = BrickedVolume::kCells, kEdge = BrickedVolume::kEdge, kBrick = BrickedVolume::kBrick;
-    // Entries per brick, y row and z slice of layout L (an entry: a sample, or a y-pair).
+    // Entries per brick, y row and z slice of layout L (an entry: a sample, a y-pair or a
+    // y-z quad).
     template <VoxelLayout L>
-    static constexpr int kBrickStride = L == VoxelLayout::YPairs ? BrickedVolume::kPairEntries : kBrick;
+    static constexpr int kBrickStride = L == VoxelLayout::YPairs    ? BrickedVolume::kPairEntries
+                                        : L == VoxelLayout::YZQuads ? BrickedVolume::kQuadEntries
+                                                                    : kBrick;
     template <VoxelLayout L>
-    static constexpr int kRowStride = L == VoxelLayout::YPairs ? BrickedVolume::kPairRow : kEdge;
+    static constexpr int kRowStride = L == VoxelLayout::YPairs    ? BrickedVolume::kPairRow
+                                      : L == VoxelLayout::YZQuads ? BrickedVolume::kQuadRow
+                                                                  : kEdge;
     template <VoxelLayout L>
-    static constexpr int kSliceStride = L == VoxelLayout::YPairs ? BrickedVolume::kPairSlice : kEdge* kEdge;
+    static constexpr int kSliceStride = L == VoxelLayout::YPairs    ? BrickedVolume::kPairSlice
+                                        : L == VoxelLayout::YZQuads ? BrickedVolume::kQuadSlice
+                                                                    : kEdge* kEdge;
     const T* voxels = nullptr;  // brick pool
     const int32_t* brickStart = nullptr;
-    // The y-pair copy (null when the volume has none) and per brick its first entry.
-    const T* pairVoxels = nullptr;
-    std::vector<int32_t> pairStart;
+    // The march's copy (BrickedVolume::pairs or quads; null when the volume has neither),
+    // its layout and per brick its first entry.
+    const T* copyVoxels = nullptr;
+    VoxelLayout copyLayout = VoxelLayout::Rows;
+    std::vector<int32_t> copyStart;
     template <VoxelLayout L>
     const int32_t* entryStart() const {
-        return L == VoxelLayout::YPairs ? pairStart.data() : brickStart;
+        return L == VoxelLayout::Rows ? brickStart : copyStart.data();
     }
     int dims[3] = {0, 0, 0};
     int32_t nbx = 0, nbxy = 0;  // brick grid strides
@@ -136,11 +146,13 @@ struct VolumeScene {
         voxels = v.data<T>();
         prefetchBricks = v.pool.size() > kPrefetchPoolBytes;
         brickStart = v.brickStart.data();
-        if (sizeof(T) < 4 && !v.pairs.empty()) {
-            pairVoxels = reinterpret_cast<const T*>(v.pairs.data());
-            pairStart.resize(v.brickStart.size());
-            for (size_t i = 0; i < pairStart.size(); ++i)
-                pairStart[i] = v.brickStart[i] / kBrick * BrickedVolume::kPairEntries;
+        if (sizeof(T) < 4 && !(v.pairs.empty() && v.quads.empty())) {
+            const bool quads = !v.quads.empty();
+            copyVoxels = reinterpret_cast<const T*>(quads ? v.quads.data() : v.pairs.data());
+            copyLayout = quads ? VoxelLayout::YZQuads : VoxelLayout::YPairs;
+            const int entries = quads ? BrickedVolume::kQuadEntries : BrickedVolume::kPairEntries;
+            copyStart.resize(v.brickStart.size());
+            for (size_t i = 0; i < copyStart.size(); ++i) copyStart[i] = v.brickStart[i] / kBrick * entries;
         }
         nbx = v.nb[0];
         nbxy = v.nb[0] * v.nb[1];

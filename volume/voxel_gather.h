@@ -36,6 +36,41 @@ RTFACT_INLINE void splitPairs8(__m256 lo, __m256 hi, simd::nvec<float, 8>& even,
 }
 #endif
 
+// The four bytes of each 32-bit lane of g as floats: byte 0 -> b0 ... byte 3 -> b3 (the
+// middle two zero-extended by one byte shuffle each; byte indices are within the 128-bit
+// lane: dword k's byte b is 4k + b).
+#if RTFACT_NATIVE_WIDTH == 8
+RTFACT_INLINE void splitBytes(__m256i g, simd::nvec<float, 8>& b0, simd::nvec<float, 8>& b1, simd::nvec<float, 8>& b2,
+                              simd::nvec<float, 8>& b3) {
+    using simd::nvec;
+    const __m256i byte1 = _mm256_setr_epi32(int(0x80808001u), int(0x80808005u), int(0x80808009u), int(0x8080800Du),
+                                            int(0x80808001u), int(0x80808005u), int(0x80808009u), int(0x8080800Du));
+    const __m256i byte2 = _mm256_add_epi32(byte1, _mm256_set1_epi32(1));
+    b0 = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, _mm256_set1_epi32(0xFF)));
+    b1 = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_shuffle_epi8(g, byte1));
+    b2 = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_shuffle_epi8(g, byte2));
+    b3 = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(g, 24));
+}
+#endif
+#if RTFACT_NATIVE_WIDTH >= 16
+RTFACT_INLINE void splitBytes(__m512i g, simd::nvec<float, 16>& b0, simd::nvec<float, 16>& b1,
+                              simd::nvec<float, 16>& b2, simd::nvec<float, 16>& b3) {
+    using simd::nvec;
+    const __m512i m = _mm512_set1_epi32(0xFF);
+    b0 = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(g, m));
+#if defined(__AVX512BW__)
+    const __m512i byte1 = _mm512_set4_epi32(int(0x8080800Du), int(0x80808009u), int(0x80808005u), int(0x80808001u));
+    const __m512i byte2 = _mm512_add_epi32(byte1, _mm512_set1_epi32(1));
+    b1 = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte1));
+    b2 = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte2));
+#else
+    b1 = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 8), m));
+    b2 = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 16), m));
+#endif
+    b3 = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_srli_epi32(kAll16, g, 24));
+}
+#endif
+
 template <class T, int W>
 RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packet<W>& a, Packet<W>& b) {
     using namespace simd;
@@ -120,17 +155,9 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
 #if RTFACT_NATIVE_WIDTH == 8
     if constexpr (W == 8) {
         if constexpr (sizeof(T) == 1) {
-            // bytes a0 a1 b0 b1 of each dword; the middle two zero-extended by one shuffle each
-            const __m256i g = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 2);
-            // (byte indices are within the 128-bit lane: dword k's byte b is 4k + b)
-            const __m256i byte1 =
-                _mm256_setr_epi32(int(0x80808001u), int(0x80808005u), int(0x80808009u), int(0x8080800Du),
-                                  int(0x80808001u), int(0x80808005u), int(0x80808009u), int(0x8080800Du));
-            const __m256i byte2 = _mm256_add_epi32(byte1, _mm256_set1_epi32(1));
-            a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, _mm256_set1_epi32(0xFF)));
-            a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_shuffle_epi8(g, byte1));
-            b0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_shuffle_epi8(g, byte2));
-            b1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(g, 24));
+            // bytes a0 a1 b0 b1 of each dword
+            splitBytes(_mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 2), a0.c[0], a1.c[0], b0.c[0],
+                       b1.c[0]);
         } else {
             // entry idx and idx + 1 by two 32-bit gathers: no reordering of 64-bit elements
             const __m256i ga = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 4);
@@ -147,27 +174,9 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
 #if RTFACT_NATIVE_WIDTH >= 16
     if constexpr (W == 16) {
         if constexpr (sizeof(T) == 1) {
-            const __m512i g =
-                _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), kAll16, (__m512i)idx.c[0], (const void*)base, 2);
-            const __m512i m = _mm512_set1_epi32(0xFF);
-            a0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(g, m));
-#if defined(__AVX512BW__)
-            // the middle two bytes zero-extended by one shuffle each
-            // (byte indices are within the 128-bit lane: dword k's byte b is 4k + b)
-            const __m512i byte1 =
-                _mm512_set4_epi32(int(0x8080800Du), int(0x80808009u), int(0x80808005u), int(0x80808001u));
-            const __m512i byte2 = _mm512_add_epi32(byte1, _mm512_set1_epi32(1));
-            a1.c[0] =
-                (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte1));
-            b0.c[0] =
-                (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_shuffle_epi8(~__mmask64(0), g, byte2));
-#else
-            a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(
-                kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 8), m));
-            b0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(
-                kAll16, _mm512_and_si512(_mm512_maskz_srli_epi32(kAll16, g, 16), m));
-#endif
-            b1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_srli_epi32(kAll16, g, 24));
+            splitBytes(
+                _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), kAll16, (__m512i)idx.c[0], (const void*)base, 2),
+                a0.c[0], a1.c[0], b0.c[0], b1.c[0]);
         } else {
             const __m512i lo =
                 _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 4);
@@ -192,6 +201,60 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
         a1[i] = float(p[1]);
         b0[i] = float(p[2]);
         b1[i] = float(p[3]);
+    }
+}
+
+// The eight corners of a cell from the y-z quad layout (BrickedVolume::quads, u8): entry
+// idx holds the samples (x, y, z), (x, y + 1, z), (x, y, z + 1), (x, y + 1, z + 1), entry
+// idx + 1 the same at x + 1: one 64-bit gather per lane fetches both (half the gathered
+// elements of the y-pairs' two 32-bit gathers). a_k: corner k of x, b_k of x + 1.
+template <int W>
+RTFACT_INLINE void fetchCube(const uint8_t* base, const Packet<W, int32_t>& idx, Packet<W>& a0, Packet<W>& a1,
+                             Packet<W>& a2, Packet<W>& a3, Packet<W>& b0, Packet<W>& b1, Packet<W>& b2, Packet<W>& b3) {
+    using namespace simd;
+    if constexpr (Packet<W>::C > 1) {
+        for (int k = 0; k < Packet<W>::C; ++k)
+            fetchCube<Packet<W>::W>(base, idx.chunk(k), a0.chunk(k), a1.chunk(k), a2.chunk(k), a3.chunk(k), b0.chunk(k),
+                                    b1.chunk(k), b2.chunk(k), b3.chunk(k));
+        return;
+    }
+#if RTFACT_NATIVE_WIDTH == 8
+    if constexpr (W == 8) {
+        // Lanes 0, 1, 4, 5 in the first gather and 2, 3, 6, 7 in the second, so that one
+        // in-lane shuffle each sorts the (x, x + 1) dword pairs into x and x + 1 vectors.
+        const __m256i q = _mm256_permute4x64_epi64((__m256i)idx.c[0], 0xD8);
+        const __m256 lo =
+            _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, _mm256_castsi256_si128(q), 4));
+        const __m256 hi =
+            _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, _mm256_extracti128_si256(q, 1), 4));
+        splitBytes(_mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0x88)), a0.c[0], a1.c[0], a2.c[0], a3.c[0]);
+        splitBytes(_mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0xDD)), b0.c[0], b1.c[0], b2.c[0], b3.c[0]);
+        return;
+    }
+#endif
+#if RTFACT_NATIVE_WIDTH >= 16
+    if constexpr (W == 16) {
+        const __m512i lo =
+            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 4);
+        const __m512i hi =
+            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx.c[0]), (const void*)base, 4);
+        const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+        const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+        splitBytes(_mm512_permutex2var_epi32(lo, even, hi), a0.c[0], a1.c[0], a2.c[0], a3.c[0]);
+        splitBytes(_mm512_permutex2var_epi32(lo, odd, hi), b0.c[0], b1.c[0], b2.c[0], b3.c[0]);
+        return;
+    }
+#endif
+    for (int i = 0; i < W; ++i) {
+        const uint8_t* p = base + 4 * size_t(uint32_t(idx[i]));
+        a0[i] = float(p[0]);
+        a1[i] = float(p[1]);
+        a2[i] = float(p[2]);
+        a3[i] = float(p[3]);
+        b0[i] = float(p[4]);
+        b1[i] = float(p[5]);
+        b2[i] = float(p[6]);
+        b3[i] = float(p[7]);
     }
 }
 

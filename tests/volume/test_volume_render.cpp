@@ -266,6 +266,12 @@ TEST(VolumeBricks, MatchDenseGridAndShareZeroBricks) {
     EXPECT_LE(double(b.pool.capacity()), 1.5 * double(g.voxelCount() * 2) + 4096.0);
     // the y-pair copy: 8 x 9 x 9 pairs per brick (1.78x the pool)
     EXPECT_LE(double(b.pairs.capacity()), 1.78 * double(b.pool.capacity()) + 4096.0);
+    EXPECT_TRUE(b.quads.empty()) << "u16 gets y-pairs";
+    // u8: the y-z quads, 8 x 8 x 9 quads per brick (3.16x the pool), and no pairs
+    const BrickedVolume b8 = brickVolume(makeSheppLogan(37, Storage::U8));
+    ASSERT_FALSE(b8.quads.empty());
+    EXPECT_TRUE(b8.pairs.empty());
+    EXPECT_LE(double(b8.quads.capacity()), 3.16 * double(b8.pool.capacity()) + 4096.0);
 }
 
 // OpenVDB input is bricked from the sparse tree; it must render like the densified grid.

@@ -1,7 +1,8 @@
-// The y-pair voxel layout (BrickedVolume::pairs): its trilinear samples equal the brick
-// pool's bit for bit and a brute-force trilinear over BrickedVolume::stored, at random
-// positions of u8 and u16 volumes whose sizes are not brick multiples; f32 has no pairs;
-// a march from either layout gives the same image.
+// The march's voxel copies (BrickedVolume::quads for u8, BrickedVolume::pairs for u16 and,
+// on request, u8): their trilinear samples equal the brick pool's bit for bit and a
+// brute-force trilinear over BrickedVolume::stored, at random positions of u8 and u16
+// volumes whose sizes are not brick multiples; f32 has no copy; a march from either layout
+// gives the same image.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -52,16 +53,26 @@ float bruteForce(const BrickedVolume& v, Vec3f p) {
     return d0 + (d1 - d0) * fz;
 }
 
-template <class T>
+template <class T, VoxelLayout L>
 void checkLayouts(Storage st, float maxValue) {
-    const BrickedVolume bv = brickVolume(randomGrid<T>(st, maxValue));
-    ASSERT_FALSE(bv.pairs.empty()) << "a small u8/u16 volume gets y-pairs";
+    static_assert(L != VoxelLayout::Rows);
+    BrickedVolume bv = brickVolume(randomGrid<T>(st, maxValue));
     EXPECT_LT(bv.storedBricks(), bv.brickCount());
-    // 8 y-pairs x 9 x 9 entries of two samples per stored brick (and the zero brick)
-    EXPECT_EQ(bv.pairs.size(), (bv.storedBricks() + 1) * size_t(BrickedVolume::kPairEntries) * 2 * sizeof(T) + 64);
+    // per stored brick (and the zero brick): 9 x 8 x 9 y-pairs of two samples, or
+    // 9 x 8 x 8 y-z quads of four
+    const size_t entries = L == VoxelLayout::YZQuads ? BrickedVolume::kQuadEntries : BrickedVolume::kPairEntries;
+    const size_t perEntry = (L == VoxelLayout::YZQuads ? 4 : 2) * sizeof(T);
+    if (L == VoxelLayout::YPairs && st == Storage::U8) {
+        ASSERT_TRUE(buildMarchCopy(bv, false));
+    }
+    const std::vector<uint8_t>& copy = L == VoxelLayout::YZQuads ? bv.quads : bv.pairs;
+    ASSERT_FALSE(copy.empty()) << "a small volume gets its march copy";
+    EXPECT_TRUE((L == VoxelLayout::YZQuads ? bv.pairs : bv.quads).empty()) << "one copy at most";
+    EXPECT_EQ(copy.size(), (bv.storedBricks() + 1) * entries * perEntry + 64);
     TransferFunction tf = transferFunctionPreset("grayscale");
     const VolumeScene<T> s(bv, buildTable(tf, {0.0f, maxValue}, 0.5f), {});
-    ASSERT_NE(s.pairVoxels, nullptr);
+    ASSERT_NE(s.copyVoxels, nullptr);
+    ASSERT_EQ(s.copyLayout, L);
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (int it = 0; it < 400; ++it) {
@@ -74,15 +85,14 @@ void checkLayouts(Storage st, float maxValue) {
         }
         const Vec3<kW> c = VolumeIntegrator::clampToGrid<kW>(s, p);
         const Packet<kW> rows = VolumeIntegrator::sample<kW, VoxelLayout::Rows>(s, c);
-        const Packet<kW> pairs = VolumeIntegrator::sample<kW, VoxelLayout::YPairs>(s, c);
+        const Packet<kW> fromCopy = VolumeIntegrator::sample<kW, L>(s, c);
         for (int i = 0; i < kW; ++i) {
             const Vec3f q(c.x[i], c.y[i], c.z[i]);
-            ASSERT_EQ(pairs[i], rows[i]) << q.x << "," << q.y << "," << q.z;
-            const Packet<1> one =
-                VolumeIntegrator::sample<1, VoxelLayout::YPairs>(s, VolumeIntegrator::clampToGrid<1>(s, Vec3<1>(q)));
-            ASSERT_EQ(float(one), pairs[i]) << q.x << "," << q.y << "," << q.z;
+            ASSERT_EQ(fromCopy[i], rows[i]) << q.x << "," << q.y << "," << q.z;
+            const Packet<1> one = VolumeIntegrator::sample<1, L>(s, VolumeIntegrator::clampToGrid<1>(s, Vec3<1>(q)));
+            ASSERT_EQ(float(one), fromCopy[i]) << q.x << "," << q.y << "," << q.z;
             const float ref = bruteForce(bv, q);
-            ASSERT_NEAR(pairs[i], ref, 1e-5f * std::max(1.0f, std::fabs(ref))) << q.x << "," << q.y << "," << q.z;
+            ASSERT_NEAR(fromCopy[i], ref, 1e-5f * std::max(1.0f, std::fabs(ref))) << q.x << "," << q.y << "," << q.z;
         }
     }
 }
@@ -114,33 +124,44 @@ std::vector<float> renderDvr(const BrickedVolume& bv, VolumeMode mode) {
 
 }  // namespace
 
-TEST(VoxelLayout, YPairsEqualRowsU8) { checkLayouts<uint8_t>(Storage::U8, 255.0f); }
-TEST(VoxelLayout, YPairsEqualRowsU16) { checkLayouts<uint16_t>(Storage::U16, 65535.0f); }
+TEST(VoxelLayout, YZQuadsEqualRowsU8) { checkLayouts<uint8_t, VoxelLayout::YZQuads>(Storage::U8, 255.0f); }
+TEST(VoxelLayout, YPairsEqualRowsU8) { checkLayouts<uint8_t, VoxelLayout::YPairs>(Storage::U8, 255.0f); }
+TEST(VoxelLayout, YPairsEqualRowsU16) { checkLayouts<uint16_t, VoxelLayout::YPairs>(Storage::U16, 65535.0f); }
 
-TEST(VoxelLayout, F32HasNoPairs) {
+TEST(VoxelLayout, F32HasNoCopy) {
     const BrickedVolume bv = brickVolume(randomGrid<float>(Storage::F32, 1.0f));
     EXPECT_TRUE(bv.pairs.empty());
+    EXPECT_TRUE(bv.quads.empty());
     const VolumeScene<float> s(bv, buildTable(transferFunctionPreset("grayscale"), {0.0f, 1.0f}, 0.5f), {});
-    EXPECT_EQ(s.pairVoxels, nullptr);
+    EXPECT_EQ(s.copyVoxels, nullptr);
+    EXPECT_EQ(s.copyLayout, VoxelLayout::Rows);
 }
 
-// Without the y-pairs (the memory budget's fallback) the march reads the pool: same image,
-// in every mode.
-TEST(VoxelLayout, ImagesEqualWithoutPairs) {
-    BrickedVolume with = brickVolume(makeSheppLogan(45, Storage::U16));
-    BrickedVolume without = with;
-    without.pairs.clear();
-    ASSERT_FALSE(with.pairs.empty());
-    for (VolumeMode m : {VolumeMode::DVR, VolumeMode::Shaded, VolumeMode::MIP, VolumeMode::Iso}) {
-        const std::vector<float> a = renderDvr(with, m), b = renderDvr(without, m);
-        ASSERT_EQ(a.size(), b.size());
-        float maxDiff = 0, sum = 0;
-        for (size_t i = 0; i < a.size(); ++i) {
-            maxDiff = std::max(maxDiff, std::fabs(a[i] - b[i]));
-            sum += a[i];
+// Without the march's copy (the memory budget's fallback) the march reads the pool, and
+// u8 y-pairs give what u8 quads give: same image, in every mode.
+TEST(VoxelLayout, ImagesEqualWithoutCopy) {
+    for (Storage st : {Storage::U16, Storage::U8}) {
+        BrickedVolume with = brickVolume(makeSheppLogan(45, st));
+        ASSERT_FALSE((st == Storage::U8 ? with.quads : with.pairs).empty());
+        BrickedVolume without = with;
+        without.pairs.clear();
+        without.quads.clear();
+        BrickedVolume pairs = with;
+        if (st == Storage::U8) {
+            ASSERT_TRUE(buildMarchCopy(pairs, false));
         }
-        EXPECT_EQ(maxDiff, 0.0f) << int(m);
-        EXPECT_GT(sum, 0.0f) << int(m);  // something was drawn
+        for (VolumeMode m : {VolumeMode::DVR, VolumeMode::Shaded, VolumeMode::MIP, VolumeMode::Iso}) {
+            const std::vector<float> a = renderDvr(with, m), b = renderDvr(without, m), c = renderDvr(pairs, m);
+            ASSERT_EQ(a.size(), b.size());
+            ASSERT_EQ(a.size(), c.size());
+            float maxDiff = 0, sum = 0;
+            for (size_t i = 0; i < a.size(); ++i) {
+                maxDiff = std::max({maxDiff, std::fabs(a[i] - b[i]), std::fabs(a[i] - c[i])});
+                sum += a[i];
+            }
+            EXPECT_EQ(maxDiff, 0.0f) << int(m) << " storage " << int(st);
+            EXPECT_GT(sum, 0.0f) << int(m);  // something was drawn
+        }
     }
 }
 
@@ -150,6 +171,7 @@ TEST(VoxelLayout, ImagesEqualWithoutPairs) {
 TEST(VoxelLayout, BrickPrefetchChangesNoPixel) {
     BrickedVolume bv = brickVolume(makeSheppLogan(45, Storage::U16));
     bv.pairs.clear();  // the row layout, the one that prefetches
+    bv.quads.clear();
     const TransferFunction tf = transferFunctionPreset("ct-bone");
     const auto [lo, hi] = bv.valueRange();
     VolumeRenderSettings rs;
