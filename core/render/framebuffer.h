@@ -28,13 +28,12 @@ class RGBAFramebuffer {
     void write(const PixelSample<N>& s, const Radiance<N>& r, const Mask<N>& valid) {
         const bool over = s.sample == overwriteSample_, overDepth = over && overwriteDepth_;
         simd::BitMask<N> bits(valid);
-        int i = 0;
 #if defined(__SSE2__)
         // Runs of 4 lanes on 4 consecutive pixels of a row (the renderers' packet blocks are
         // at least 4 wide): one 4x4 transpose and 4 vector stores instead of 16 scalar
         // read-modify-writes. At 1024^2 the scalar loop took 5% of a volume frame.
         const __m128i step = _mm_setr_epi32(0, 1, 2, 3);
-        for (; i + 4 <= N; i += 4) {
+        for (int i = 0; i + 4 <= N; i += 4) {
             if (((bits.w[i >> 6] >> (i & 63)) & 0xF) != 0xF) continue;
             const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&s.px[i]));
             const __m128i y = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&s.py[i]));
@@ -63,14 +62,14 @@ class RGBAFramebuffer {
             bits.w[i >> 6] &= ~(uint64_t(0xF) << (i & 63));  // done
         }
 #endif
-        for (i = 0; i < N; ++i) {
-            if (!bits[i]) continue;
-            const size_t p = size_t(s.py[i]) * size_t(w_) + size_t(s.px[i]);
+        // the lanes left, by their bits (a test of all N lanes cost 1.5% of a volume frame)
+        bits.forEach([&](int k) {
+            const size_t p = size_t(s.py[k]) * size_t(w_) + size_t(s.px[k]);
             float* d = &rgba_[p * 4];
-            const float c[4] = {r.color.x[i], r.color.y[i], r.color.z[i], r.alpha[i]};
-            for (int k = 0; k < 4; ++k) d[k] = over ? c[k] : d[k] + c[k];
-            if (!depth_.empty()) depth_[p] = overDepth ? float(r.depth[i]) : std::min(depth_[p], float(r.depth[i]));
-        }
+            const float c[4] = {r.color.x[k], r.color.y[k], r.color.z[k], r.alpha[k]};
+            for (int j = 0; j < 4; ++j) d[j] = over ? c[j] : d[j] + c[j];
+            if (!depth_.empty()) depth_[p] = overDepth ? float(r.depth[k]) : std::min(depth_[p], float(r.depth[k]));
+        });
     }
 
     // Asks for the pixels of s (one cache line per run of 4 from x % 4 == 0) ahead of their
