@@ -421,7 +421,8 @@ struct VolumeIntegrator {
                             const P w = (P(1.0f) - alpha) * a;
                             col += rgb * w;
                             alpha += w;
-                            depth = select(contrib & (depth == P(kInfinity)), t, depth);
+                            // t grows along the ray: the first contribution's is the least
+                            depth = min(depth, select(contrib, t, P(kInfinity)));
                         }
                         alive = alive & (alpha < term);
                     }
