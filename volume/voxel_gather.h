@@ -22,6 +22,16 @@ inline constexpr __mmask8 kAll8 = 0xFF;
 // The two 8-lane halves of 16 indices, as intrinsic operands.
 RTFACT_INLINE __m256i lowHalf(simd::nvec<int32_t, 16> v) { return (__m256i)simd::lowHalf<16>(v); }
 RTFACT_INLINE __m256i highHalf(simd::nvec<int32_t, 16> v) { return (__m256i)simd::highHalf<16>(v); }
+// Per lane the 32-bit entries idx and idx + 1 of base, by one 64-bit gather each (two 8-lane
+// gathers), sorted into the first entries and the second.
+RTFACT_INLINE void gatherEntryPairs(const void* base, simd::nvec<int32_t, 16> idx, __m512i& first, __m512i& second) {
+    const __m512i lo = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx), base, 4);
+    const __m512i hi = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx), base, 4);
+    const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+    const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+    first = _mm512_permutex2var_epi32(lo, even, hi);
+    second = _mm512_permutex2var_epi32(lo, odd, hi);
+}
 #endif
 
 #if RTFACT_NATIVE_WIDTH == 8
@@ -178,14 +188,8 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
                 _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), kAll16, (__m512i)idx.c[0], (const void*)base, 2),
                 a0.c[0], a1.c[0], b0.c[0], b1.c[0]);
         } else {
-            const __m512i lo =
-                _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 4);
-            const __m512i hi =
-                _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx.c[0]), (const void*)base, 4);
-            const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-            const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
-            const __m512i ia = _mm512_permutex2var_epi32(lo, even, hi);  // a0 | a1 << 16
-            const __m512i ib = _mm512_permutex2var_epi32(lo, odd, hi);   // b0 | b1 << 16
+            __m512i ia, ib;  // a0 | a1 << 16, b0 | b1 << 16
+            gatherEntryPairs(base, idx.c[0], ia, ib);
             const __m512i m = _mm512_set1_epi32(0xFFFF);
             a0.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_and_si512(ia, m));
             a1.c[0] = (nvec<float, 16>)_mm512_maskz_cvtepi32_ps(kAll16, _mm512_maskz_srli_epi32(kAll16, ia, 16));
@@ -234,14 +238,10 @@ RTFACT_INLINE void fetchCube(const uint8_t* base, const Packet<W, int32_t>& idx,
 #endif
 #if RTFACT_NATIVE_WIDTH >= 16
     if constexpr (W == 16) {
-        const __m512i lo =
-            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, lowHalf(idx.c[0]), (const void*)base, 4);
-        const __m512i hi =
-            _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), kAll8, highHalf(idx.c[0]), (const void*)base, 4);
-        const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-        const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
-        splitBytes(_mm512_permutex2var_epi32(lo, even, hi), a0.c[0], a1.c[0], a2.c[0], a3.c[0]);
-        splitBytes(_mm512_permutex2var_epi32(lo, odd, hi), b0.c[0], b1.c[0], b2.c[0], b3.c[0]);
+        __m512i ia, ib;
+        gatherEntryPairs(base, idx.c[0], ia, ib);
+        splitBytes(ia, a0.c[0], a1.c[0], a2.c[0], a3.c[0]);
+        splitBytes(ib, b0.c[0], b1.c[0], b2.c[0], b3.c[0]);
         return;
     }
 #endif
