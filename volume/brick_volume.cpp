@@ -66,43 +66,25 @@ void BrickBuilder::finish(BrickedVolume& v) {
 }
 
 namespace {
-template <class T>
-void fillPairs(BrickedVolume& v) {
+// Fills a march copy of v.pool (BrickedVolume::pairs or quads): entry (x, y, z) of a brick,
+// for x < kEdge, y < kCells, z < zCount, holds the K pool samples at (x, y, z) + offs[k]
+// (pool offsets); entries are x-major with the layout's row and slice strides.
+template <class T, int K>
+void fillCopy(BrickedVolume& v, std::vector<uint8_t>& copy, int zCount, int row, int slice, const int (&offs)[K]) {
     using BV = BrickedVolume;
     const size_t bricks = v.pool.size() / (size_t(BV::kBrick) * sizeof(T));
+    const size_t entries = size_t(slice) * size_t(zCount);
     const T* src = v.data<T>();
-    T* dst = reinterpret_cast<T*>(v.pairs.data());
+    T* dst = reinterpret_cast<T*>(copy.data());
     tbb::parallel_for(size_t(0), bricks, [&](size_t b) {
         const T* s = src + b * size_t(BV::kBrick);
-        T* d = dst + b * size_t(BV::kPairEntries) * 2;
-        for (int z = 0; z < BV::kEdge; ++z)
+        T* d = dst + b * entries * K;
+        for (int z = 0; z < zCount; ++z)
             for (int y = 0; y < BV::kCells; ++y)
                 for (int x = 0; x < BV::kEdge; ++x) {
-                    const size_t e = size_t(x + y * BV::kPairRow + z * BV::kPairSlice) * 2;
-                    d[e] = s[x + y * BV::kEdge + z * BV::kEdge * BV::kEdge];
-                    d[e + 1] = s[x + (y + 1) * BV::kEdge + z * BV::kEdge * BV::kEdge];
-                }
-    });
-}
-
-// y-z quads of u8 samples (BrickedVolume::quads)
-void fillQuads(BrickedVolume& v) {
-    using BV = BrickedVolume;
-    const size_t bricks = v.pool.size() / size_t(BV::kBrick);
-    const uint8_t* src = v.pool.data();
-    uint8_t* dst = v.quads.data();
-    tbb::parallel_for(size_t(0), bricks, [&](size_t b) {
-        const uint8_t* s = src + b * size_t(BV::kBrick);
-        uint8_t* d = dst + b * size_t(BV::kQuadEntries) * 4;
-        for (int z = 0; z < BV::kCells; ++z)
-            for (int y = 0; y < BV::kCells; ++y)
-                for (int x = 0; x < BV::kEdge; ++x) {
-                    const size_t e = size_t(x + y * BV::kQuadRow + z * BV::kQuadSlice) * 4;
-                    const uint8_t* c = s + x + y * BV::kEdge + z * BV::kEdge * BV::kEdge;
-                    d[e] = c[0];
-                    d[e + 1] = c[BV::kEdge];
-                    d[e + 2] = c[BV::kEdge * BV::kEdge];
-                    d[e + 3] = c[BV::kEdge + BV::kEdge * BV::kEdge];
+                    const T* c = s + x + y * BV::kEdge + z * BV::kEdge * BV::kEdge;
+                    T* e = d + size_t(x + y * row + z * slice) * K;
+                    for (int k = 0; k < K; ++k) e[k] = c[offs[k]];
                 }
     });
 }
@@ -131,15 +113,17 @@ bool buildMarchCopy(BrickedVolume& v, bool allowQuads) {
     };
     if (v.storage == Storage::U8 && allowQuads && fits(BV::kQuadEntries, 4)) {
         v.quads.assign(size_t(bricks) * BV::kQuadEntries * 4 + 64, 0);
-        fillQuads(v);
+        constexpr int kYZQuad[4] = {0, BV::kEdge, BV::kEdge * BV::kEdge, BV::kEdge + BV::kEdge * BV::kEdge};
+        fillCopy<uint8_t>(v, v.quads, BV::kCells, BV::kQuadRow, BV::kQuadSlice, kYZQuad);
         return true;
     }
     if (!fits(BV::kPairEntries, 2 * bytes)) return false;
     v.pairs.assign(size_t(bricks) * BV::kPairEntries * 2 * bytes + 64, 0);
+    constexpr int kYPair[2] = {0, BV::kEdge};
     if (v.storage == Storage::U8)
-        fillPairs<uint8_t>(v);
+        fillCopy<uint8_t>(v, v.pairs, BV::kEdge, BV::kPairRow, BV::kPairSlice, kYPair);
     else
-        fillPairs<uint16_t>(v);
+        fillCopy<uint16_t>(v, v.pairs, BV::kEdge, BV::kPairRow, BV::kPairSlice, kYPair);
     return true;
 }
 
