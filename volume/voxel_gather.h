@@ -82,20 +82,23 @@ RTFACT_INLINE void splitBytes(__m512i g, simd::nvec<float, 16>& b0, simd::nvec<f
 #endif
 
 #if RTFACT_NATIVE_WIDTH == 8
-// The 8 bytes at base + S * ix[i] for lanes i0 .. i3, as the four 64-bit words of a vector:
-// AVX2's 64-bit fetches (quads, TF entries) take scalar loads instead of vpgatherdq. On Zen 4
-// (AVX2 build, tooth) the frame took 55.5 ms against 59.8 with the gathers (the u16 pairs'
-// 32-bit gathers as scalar loads: no faster, they stay gathers).
+// The 8 bytes at base + S * idx[i] per lane, lanes[0..3] into lo and lanes[4..7] into hi as
+// their 64-bit words: AVX2's 64-bit fetches (quads, TF entries) take scalar loads instead of
+// vpgatherdq. On Zen 4 (AVX2 build, tooth) the frame took 55.5 ms against 59.8 with the
+// gathers (the pairs' 32-bit gathers as scalar loads: no faster, they stay gathers).
 template <size_t S>
-RTFACT_INLINE __m256i loadQwords4(const void* base, const int32_t* ix, int i0, int i1, int i2, int i3) {
+RTFACT_INLINE void loadQwords8(const void* base, __m256i idx, const int (&lanes)[8], __m256i& lo, __m256i& hi) {
+    alignas(32) int32_t ix[8];
+    _mm256_store_si256((__m256i*)ix, idx);
     const auto* b = static_cast<const uint8_t*>(base);
     auto pair = [&](int i, int j) __attribute__((always_inline)) {
-        const __m128i x = _mm_loadl_epi64((const __m128i*)(b + S * size_t(uint32_t(ix[i]))));
+        const __m128i x = _mm_loadl_epi64((const __m128i*)(b + S * size_t(uint32_t(ix[lanes[i]]))));
         long long y;
-        std::memcpy(&y, b + S * size_t(uint32_t(ix[j])), 8);
+        std::memcpy(&y, b + S * size_t(uint32_t(ix[lanes[j]])), 8);
         return _mm_insert_epi64(x, y, 1);
     };
-    return _mm256_set_m128i(pair(i2, i3), pair(i0, i1));
+    lo = _mm256_set_m128i(pair(2, 3), pair(0, 1));
+    hi = _mm256_set_m128i(pair(6, 7), pair(4, 5));
 }
 #endif
 
@@ -229,7 +232,8 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
 // The eight corners of a cell from the y-z quad layout (BrickedVolume::quads, u8): entry
 // idx holds the samples (x, y, z), (x, y + 1, z), (x, y, z + 1), (x, y + 1, z + 1), entry
 // idx + 1 the same at x + 1: one 64-bit fetch per lane reads both (half the fetched
-// elements of the y-pairs' two 32-bit gathers; AVX2: scalar loads, loadQwords4). a_k: corner k of x, b_k of x + 1.
+// elements of the y-pairs' two 32-bit gathers; AVX2: scalar loads, loadQwords8). a_k: corner
+// k of x, b_k of x + 1.
 template <int W>
 RTFACT_INLINE void fetchCube(const uint8_t* base, const Packet<W, int32_t>& idx, Packet<W>& a0, Packet<W>& a1,
                              Packet<W>& a2, Packet<W>& a3, Packet<W>& b0, Packet<W>& b1, Packet<W>& b2, Packet<W>& b3) {
@@ -244,10 +248,9 @@ RTFACT_INLINE void fetchCube(const uint8_t* base, const Packet<W, int32_t>& idx,
     if constexpr (W == 8) {
         // Lanes 0, 1, 4, 5 in the first vector and 2, 3, 6, 7 in the second, so that one
         // in-lane shuffle each sorts the (x, x + 1) dword pairs into x and x + 1 vectors.
-        alignas(32) int32_t ix[8];
-        _mm256_store_si256((__m256i*)ix, (__m256i)idx.c[0]);
-        const __m256 lo = _mm256_castsi256_ps(loadQwords4<4>(base, ix, 0, 1, 4, 5));
-        const __m256 hi = _mm256_castsi256_ps(loadQwords4<4>(base, ix, 2, 3, 6, 7));
+        __m256i qlo, qhi;
+        loadQwords8<4>(base, (__m256i)idx.c[0], {0, 1, 4, 5, 2, 3, 6, 7}, qlo, qhi);
+        const __m256 lo = _mm256_castsi256_ps(qlo), hi = _mm256_castsi256_ps(qhi);
         splitBytes(_mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0x88)), a0.c[0], a1.c[0], a2.c[0], a3.c[0]);
         splitBytes(_mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0xDD)), b0.c[0], b1.c[0], b2.c[0], b3.c[0]);
         return;
@@ -293,10 +296,8 @@ RTFACT_INLINE void fetchRgbaHalf(const uint64_t* base, const Packet<W, int32_t>&
         const __m256i bytes = _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, 8, 9, 2, 3,
                                                10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
         const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-        alignas(32) int32_t ix[8];
-        _mm256_store_si256((__m256i*)ix, (__m256i)idx.c[0]);
-        const __m256i lo = loadQwords4<8>(base, ix, 0, 1, 2, 3);
-        const __m256i hi = loadQwords4<8>(base, ix, 4, 5, 6, 7);
+        __m256i lo, hi;
+        loadQwords8<8>(base, (__m256i)idx.c[0], {0, 1, 2, 3, 4, 5, 6, 7}, lo, hi);
         // lanes 0-3 (4-7): r r r r g g g g | b b b b a a a a
         const __m256i l = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(lo, bytes), order);
         const __m256i h = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(hi, bytes), order);
