@@ -332,13 +332,15 @@ struct LoDWideIntersector {
             ht = select(found, PW(-kInfinity), ht);
             open &= ~uint32_t(BitMask<W>(found).w[0]);
         };
-        // An entry remembers its parent and slot, so its lanes are tested again against the
-        // hits found since it was pushed.
+        // An entry keeps its lanes' distances into the child's box (closest hit), so at its
+        // turn one compare drops the lanes whose hit, found since, lies before the box: the
+        // slab test again, since their far distances and the box are unchanged. (Re-testing
+        // the parent's slabs at every pop instead: full detail 6-7% slower, AVX2, Zen 5.)
         struct Entry {
             int32_t child, count;
             float dist;
             uint32_t lanes;
-            int32_t parent, slot;
+            float tn[AnyHit ? 1 : W];
         };
         Entry stack[(K - 1) * LoDWideBVH::kMaxDepth + 1];
         int sp = 0;
@@ -376,14 +378,22 @@ struct LoDWideIntersector {
                         if (!m) continue;
                     }
                 }
-                Entry e{n.child[c], n.count[c], 0.0f, m, node, c};
-                prefetchEntry(bvh, e.child, e.count);
+                prefetchEntry(bvh, n.child[c], n.count[c]);
                 if constexpr (AnyHit) {
-                    stack[sp++] = e;
+                    Entry& e = stack[sp++];
+                    e.child = n.child[c];
+                    e.count = n.count[c];
+                    e.dist = 0.0f;
+                    e.lanes = m;
                 } else {
                     // The interval entry bounds the lanes' entries from below: it orders the
                     // children without a horizontal minimum per child.
+                    Entry e;
+                    e.child = n.child[c];
+                    e.count = n.count[c];
                     e.dist = uniform ? entry[c] : hmin(select(tn <= ht, tn, inf));
+                    e.lanes = m;
+                    tn.store(e.tn);
                     pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
                 }
             }
@@ -391,13 +401,12 @@ struct LoDWideIntersector {
             // entries with few lanes to single rays.
             for (;;) {
                 if (sp == 0) return;
-                Entry e = stack[--sp];
+                Entry& e = stack[--sp];  // popped: read before anything is pushed again
                 if constexpr (AnyHit) {
                     e.lanes &= open;
                 } else {
                     if (!(e.dist <= fr.tMaxHi)) continue;
-                    PW tn;
-                    e.lanes &= laneHits(bvh.nodes[size_t(e.parent)].lo[0], e.slot, tn);
+                    e.lanes &= uint32_t(BitMask<W>(PW::load(e.tn) <= ht).w[0]);
                 }
                 if (!e.lanes) continue;
                 const int lanesHit = __builtin_popcount(e.lanes);
