@@ -41,8 +41,8 @@ struct VolumeIntegrator {
         // chains (brick, voxels, TF) are independent, so each hides the others' latency. Eight
         // AVX2 chunks spill too much. Pairs where more lanes cost more than they hide (measured):
         // isosurfaces (a crossing in any lane bisects all), and on AVX2 MIP (a short step: the
-        // spills weigh more) and volumes larger than the caches (brick prefetches; fewer lanes
-        // wait for the longest ray of the group).
+        // spills weigh more) and brick pools the row layout prefetches (fewer lanes wait for
+        // the longest ray of the group; measured so, the march's copy keeps four).
         constexpr int W = Packet<N>::W, C = Packet<N>::C, G = C % 4 == 0 ? 4 : C % 2 == 0 ? 2 : 1;
         constexpr int G2 = G == 4 ? 2 : G;
         // The mode is fixed at compile time: the other modes' state and branches drop out of
@@ -65,7 +65,7 @@ struct VolumeIntegrator {
             if constexpr (M == VolumeMode::Iso || (W == 8 && M == VolumeMode::MIP)) {
                 marchGroups.template operator()<G2, M>();
             } else if constexpr (W == 8) {
-                if (s.prefetchBricks)
+                if (L == VoxelLayout::Rows && s.prefetchBricks)
                     marchGroups.template operator()<G2, M>();
                 else
                     marchGroups.template operator()<G, M>();
@@ -294,8 +294,8 @@ struct VolumeIntegrator {
         auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) {
             return -floor(-((tx - tNear) * invDt - P(0.5f)));
         };
-        // Volumes larger than the caches (VolumeScene::prefetchesBricks: the brick pool past 64 MB,
-        // the march's copy past 8 MB) wait on memory each time a ray enters a brick: two lanes
+        // Volumes larger than the caches (VolumeScene::prefetchesBricks: the voxels the march
+        // reads past 8 MB) wait on memory each time a ray enters a brick: two lanes
         // of the group (its first and last alive ones: opposite corners of its footprint)
         // prefetch the brick one brick edge ahead along their ray and its sub-brick entries,
         // once per brick (the last two bricks prefetched are remembered: the two lanes mostly

@@ -128,14 +128,13 @@ struct VolumeScene {
     // one 64-bit gather fetches an entry.
     std::vector<uint64_t> rgbaSteps;
     std::vector<float> cellMax;
-    // The march prefetches the bricks ahead of its rays (row layout): volumes whose pool
-    // is larger than the last-level caches, where it waits on memory at every new brick.
-    static constexpr size_t kPrefetchPoolBytes = size_t(64) << 20;
-    bool prefetchBricks = false;
-    // The same for the march's copy past 8 MB (measured, AVX2 build on Zen 5, 1 thread: the
-    // bonsai's 14.5 MB of u8 y-pairs 3-5% faster; the tooth's 7.2 MB of quads and the head
-    // CT's 2 MB of pairs 6-9% slower with the prefetches).
-    static constexpr size_t kPrefetchCopyBytes = size_t(8) << 20;
+    // The march prefetches the bricks ahead of its rays where the voxels it reads (the pool
+    // in the row layout, else the march's copy) outgrow 8 MB and it waits on memory at
+    // every new brick. Measured on Zen 5, 1 thread: the bonsai's 14.5 MB of u8 y-pairs 3%
+    // (AVX2) and 6% (AVX-512) faster, the 256^3 u16 phantom's pool 6% and 14%; the tooth's
+    // 7.2 MB of quads and the head CT's 2 MB of pairs 6-9% slower with the prefetches.
+    static constexpr size_t kPrefetchBytes = size_t(8) << 20;
+    bool prefetchBricks = false;  // the pool's
     bool prefetchCopy = false;
     template <VoxelLayout L>
     bool prefetchesBricks() const {
@@ -162,7 +161,7 @@ struct VolumeScene {
             subs[a] = 2 * v.nb[a];
         }
         voxels = v.data<T>();
-        prefetchBricks = v.pool.size() > kPrefetchPoolBytes;
+        prefetchBricks = v.pool.size() > kPrefetchBytes;
         brickStart = v.brickStart.data();
         if (sizeof(T) < 4 && !(v.pairs.empty() && v.quads.empty())) {
             const bool quads = !v.quads.empty();
@@ -171,7 +170,7 @@ struct VolumeScene {
             const int entries = quads ? BrickedVolume::kQuadEntries : BrickedVolume::kPairEntries;
             copyStart.resize(v.brickStart.size());
             for (size_t i = 0; i < copyStart.size(); ++i) copyStart[i] = v.brickStart[i] / kBrick * entries;
-            prefetchCopy = (quads ? v.quads.size() : v.pairs.size()) > kPrefetchCopyBytes;
+            prefetchCopy = (quads ? v.quads.size() : v.pairs.size()) > kPrefetchBytes;
         }
         nbx = v.nb[0];
         nbxy = v.nb[0] * v.nb[1];

@@ -165,19 +165,25 @@ TEST(VoxelLayout, ImagesEqualWithoutCopy) {
     }
 }
 
-// The march prefetches bricks ahead of its rays on volumes beyond the caches
-// (VolumeScene::prefetchBricks, row layout): forced on for a small volume, it changes no
-// pixel, from outside the box and from inside it (the brick ahead clamped to the grid).
-TEST(VoxelLayout, BrickPrefetchChangesNoPixel) {
-    BrickedVolume bv = brickVolume(makeSheppLogan(45, Storage::U16));
-    bv.pairs.clear();  // the row layout, the one that prefetches
-    bv.quads.clear();
+// The march prefetches bricks ahead of its rays where the voxels it reads outgrow the
+// caches (VolumeScene::prefetchBricks for the row layout's pool, prefetchCopy for the
+// march's copy): forced on for a small volume, it changes no pixel, from outside the box
+// and from inside it (the brick ahead clamped to the grid), in every layout.
+template <class T>
+void checkPrefetchChangesNoPixel(Storage st, VoxelLayout layout) {
+    SCOPED_TRACE(int(layout));
+    BrickedVolume bv = brickVolume(makeSheppLogan(45, st));
+    if (layout == VoxelLayout::Rows) {
+        bv.pairs.clear();
+        bv.quads.clear();
+    }
     const TransferFunction tf = transferFunctionPreset("ct-bone");
     const auto [lo, hi] = bv.valueRange();
     VolumeRenderSettings rs;
     const TFTable table = buildTable(tf, {lo, hi}, rs.stepVoxels);
-    VolumeScene<uint16_t> scene(bv, table, rs);
-    EXPECT_FALSE(scene.prefetchBricks) << "a 45^3 volume fits the caches";
+    VolumeScene<T> scene(bv, table, rs);
+    ASSERT_EQ(scene.copyLayout, layout);
+    EXPECT_FALSE(scene.prefetchBricks || scene.prefetchCopy) << "a 45^3 volume fits the caches";
     const AABB box = scene.bounds();
     const CameraFrame views[2] = {fitCamera(box, 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}),
                                   {box.center(), box.center() + Vec3f(0.7f, 0.2f, -0.4f), {0, 0, 1}, 100.0f}};
@@ -185,7 +191,7 @@ TEST(VoxelLayout, BrickPrefetchChangesNoPixel) {
         const PinholeCamera cam(view, 48, 48);
         std::vector<float> img[2];
         for (int on = 0; on < 2; ++on) {
-            scene.prefetchBricks = on == 1;
+            (layout == VoxelLayout::Rows ? scene.prefetchBricks : scene.prefetchCopy) = on == 1;
             img[on] = renderView(scene, cam, 48, 48);
         }
         float sum = 0;
@@ -195,4 +201,10 @@ TEST(VoxelLayout, BrickPrefetchChangesNoPixel) {
         }
         EXPECT_GT(sum, 0.0f);  // something was drawn
     }
+}
+
+TEST(VoxelLayout, BrickPrefetchChangesNoPixel) {
+    checkPrefetchChangesNoPixel<uint16_t>(Storage::U16, VoxelLayout::Rows);
+    checkPrefetchChangesNoPixel<uint16_t>(Storage::U16, VoxelLayout::YPairs);
+    checkPrefetchChangesNoPixel<uint8_t>(Storage::U8, VoxelLayout::YZQuads);
 }
