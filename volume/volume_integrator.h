@@ -294,7 +294,7 @@ struct VolumeIntegrator {
         auto sampleIndexAt = [&](const P& tx) __attribute__((always_inline)) {
             return -floor(-((tx - tNear) * invDt - P(0.5f)));
         };
-        // Volumes larger than the caches (VolumeScene::prefetchesBricks: the voxels the march
+        // Volumes larger than the caches (VolumeScene::prefetchBricks: the voxels the march
         // reads past 8 MB) wait on memory each time a ray enters a brick: two lanes
         // of the group (its first and last alive ones: opposite corners of its footprint)
         // prefetch the brick one brick edge ahead along their ray and its sub-brick entries,
@@ -321,13 +321,13 @@ struct VolumeIntegrator {
             __builtin_prefetch(si + sxy);
             __builtin_prefetch(si + sx + sxy);
             constexpr size_t entryBytes = Scene::template kEntryBytes<L>;
-            prefetchBytes(s.template entryBytes<L>() + size_t(s.template entryStart<L>()[id]) * entryBytes,
+            prefetchBytes(s.template entryBase<L>() + size_t(s.template entryStart<L>()[id]) * entryBytes,
                           entryBytes * size_t(Scene::template kBrickStride<L>));
         };
         uint32_t iteration = 0;
         while (any(alive)) {
             // every fourth step: the brick ahead is at least kCells / stepVoxels steps away
-            if (s.template prefetchesBricks<L>() && (iteration++ & 3) == 0) {
+            if (s.prefetchBricks && (iteration++ & 3) == 0) {
                 static_assert(W <= 64);
                 const uint64_t lanes = BitMask<W>(alive).w[0];
                 prefetchAhead(__builtin_ctzll(lanes));

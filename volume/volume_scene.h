@@ -84,7 +84,7 @@ struct VolumeScene {
                                           : L == VoxelLayout::YZQuads ? 4 * sizeof(T)
                                                                       : sizeof(T);
     template <VoxelLayout L>
-    const uint8_t* entryBytes() const {
+    const uint8_t* entryBase() const {
         return reinterpret_cast<const uint8_t*>(L == VoxelLayout::Rows ? voxels : copyVoxels);
     }
     int dims[3] = {0, 0, 0};
@@ -134,12 +134,7 @@ struct VolumeScene {
     // (AVX2) and 6% (AVX-512) faster, the 256^3 u16 phantom's pool 6% and 14%; the tooth's
     // 7.2 MB of quads and the head CT's 2 MB of pairs 6-9% slower with the prefetches.
     static constexpr size_t kPrefetchBytes = size_t(8) << 20;
-    bool prefetchBricks = false;  // the pool's
-    bool prefetchCopy = false;
-    template <VoxelLayout L>
-    bool prefetchesBricks() const {
-        return L == VoxelLayout::Rows ? prefetchBricks : prefetchCopy;
-    }
+    bool prefetchBricks = false;
     // Shaded: the voxels' central differences, per brick the TF shows (empty in the other
     // modes, and beyond kMaxGradientBytes or a quarter of the available memory: the march
     // then takes six trilinear samples a gradient). Measured (AVX-512, 1 thread): faster
@@ -161,7 +156,6 @@ struct VolumeScene {
             subs[a] = 2 * v.nb[a];
         }
         voxels = v.data<T>();
-        prefetchBricks = v.pool.size() > kPrefetchBytes;
         brickStart = v.brickStart.data();
         if (sizeof(T) < 4 && !(v.pairs.empty() && v.quads.empty())) {
             const bool quads = !v.quads.empty();
@@ -170,8 +164,12 @@ struct VolumeScene {
             const int entries = quads ? BrickedVolume::kQuadEntries : BrickedVolume::kPairEntries;
             copyStart.resize(v.brickStart.size());
             for (size_t i = 0; i < copyStart.size(); ++i) copyStart[i] = v.brickStart[i] / kBrick * entries;
-            prefetchCopy = (quads ? v.quads.size() : v.pairs.size()) > kPrefetchBytes;
         }
+        // the march reads the copy where there is one (VolumeIntegrator::eval)
+        const size_t marchBytes = copyLayout == VoxelLayout::YZQuads  ? v.quads.size()
+                                  : copyLayout == VoxelLayout::YPairs ? v.pairs.size()
+                                                                      : v.pool.size();
+        prefetchBricks = marchBytes > kPrefetchBytes;
         nbx = v.nb[0];
         nbxy = v.nb[0] * v.nb[1];
         origin = v.origin;

@@ -165,10 +165,10 @@ TEST(VoxelLayout, ImagesEqualWithoutCopy) {
     }
 }
 
-// The march prefetches bricks ahead of its rays where the voxels it reads outgrow the
-// caches (VolumeScene::prefetchBricks for the row layout's pool, prefetchCopy for the
-// march's copy): forced on for a small volume, it changes no pixel, from outside the box
-// and from inside it (the brick ahead clamped to the grid), in every layout.
+// The march prefetches bricks ahead of its rays where the voxels it reads (the row layout's
+// pool or the march's copy) outgrow the caches (VolumeScene::prefetchBricks): forced on for
+// a small volume, it changes no pixel, from outside the box and from inside it (the brick
+// ahead clamped to the grid), in every layout.
 template <class T>
 void checkPrefetchChangesNoPixel(Storage st, VoxelLayout layout) {
     SCOPED_TRACE(int(layout));
@@ -183,7 +183,7 @@ void checkPrefetchChangesNoPixel(Storage st, VoxelLayout layout) {
     const TFTable table = buildTable(tf, {lo, hi}, rs.stepVoxels);
     VolumeScene<T> scene(bv, table, rs);
     ASSERT_EQ(scene.copyLayout, layout);
-    EXPECT_FALSE(scene.prefetchBricks || scene.prefetchCopy) << "a 45^3 volume fits the caches";
+    EXPECT_FALSE(scene.prefetchBricks) << "a 45^3 volume fits the caches";
     const AABB box = scene.bounds();
     const CameraFrame views[2] = {fitCamera(box, 40.0f, 1.0f, {0.45f, -1.0f, 0.35f}, {0, 0, 1}),
                                   {box.center(), box.center() + Vec3f(0.7f, 0.2f, -0.4f), {0, 0, 1}, 100.0f}};
@@ -191,7 +191,7 @@ void checkPrefetchChangesNoPixel(Storage st, VoxelLayout layout) {
         const PinholeCamera cam(view, 48, 48);
         std::vector<float> img[2];
         for (int on = 0; on < 2; ++on) {
-            (layout == VoxelLayout::Rows ? scene.prefetchBricks : scene.prefetchCopy) = on == 1;
+            scene.prefetchBricks = on == 1;
             img[on] = renderView(scene, cam, 48, 48);
         }
         float sum = 0;
