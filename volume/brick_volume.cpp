@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/util/error.h"
+#include "core/util/huge_pages.h"
 #include "core/util/memory_budget.h"
 
 namespace rtfact::volume {
@@ -99,26 +100,28 @@ bool buildMarchCopy(BrickedVolume& v, bool allowQuads) {
     if (v.storage == Storage::F32) return false;
     const size_t bytes = size_t(storageBytes(v.storage));
     const size_t bricks = v.pool.size() / (size_t(BV::kBrick) * bytes);
-    // Only while the copy stays cache-sized: measured (session s6, both ISAs) faster on the
-    // head CT (2 MB of pairs) but slower on the bonsai (42 MB) and the 512^3 phantom
-    // (183 MB), where the march waits on cache misses and the larger copy adds to them.
-    // Optional: keep a quarter of what is available for everything else (frame buffers, a
-    // second scene), else render from the pool alone. Entries are addressed with 32-bit
-    // indices, like the pool's samples.
-    constexpr uint64_t kMaxCopyBytes = uint64_t(16) << 20;
+    // Up to 256 MB. Session s6 kept it cache-sized (16 MB): large copies were slower, the
+    // march waiting on cache misses. Since the march prefetches the copy's bricks ahead
+    // (VolumeScene::prefetchBricks) the halved fetches pay there too (Zen 5, 1 thread: AVX2
+    // bonsai with 26 MB of quads -7%, 256^3 u16 phantom with 25 MB of pairs -8% AVX-512 /
+    // -12% AVX2, 512^3 phantom with 183 MB of pairs -8% to -12% at every step). Optional:
+    // keep a quarter of what is available for everything else (frame buffers, a second
+    // scene), else render from the pool alone. Entries are addressed with 32-bit indices,
+    // like the pool's samples.
+    constexpr uint64_t kMaxCopyBytes = uint64_t(256) << 20;
     const auto fits = [&](int entries, size_t entryBytes) {
         const uint64_t need = uint64_t(bricks) * uint64_t(entries) * entryBytes + 64;
         return uint64_t(bricks) * uint64_t(entries) <= uint64_t(std::numeric_limits<int32_t>::max()) - 64 &&
                need <= kMaxCopyBytes && need <= availableMemoryBytes() / 4 * 3;
     };
     if (v.storage == Storage::U8 && allowQuads && fits(BV::kQuadEntries, 4)) {
-        v.quads.assign(size_t(bricks) * BV::kQuadEntries * 4 + 64, 0);
+        resizeFreshHugePages(v.quads, size_t(bricks) * BV::kQuadEntries * 4 + 64);
         constexpr int kYZQuad[4] = {0, BV::kEdge, BV::kEdge * BV::kEdge, BV::kEdge + BV::kEdge * BV::kEdge};
         fillCopy<uint8_t>(v, v.quads, BV::kCells, BV::kQuadRow, BV::kQuadSlice, kYZQuad);
         return true;
     }
     if (!fits(BV::kPairEntries, 2 * bytes)) return false;
-    v.pairs.assign(size_t(bricks) * BV::kPairEntries * 2 * bytes + 64, 0);
+    resizeFreshHugePages(v.pairs, size_t(bricks) * BV::kPairEntries * 2 * bytes + 64);
     constexpr int kYPair[2] = {0, BV::kEdge};
     if (v.storage == Storage::U8)
         fillCopy<uint8_t>(v, v.pairs, BV::kEdge, BV::kPairRow, BV::kPairSlice, kYPair);
@@ -161,7 +164,7 @@ void brickDense(VolumeGrid& g, BrickedVolume& v, bool release) {
         }
     if (next > int64_t(std::numeric_limits<int32_t>::max()) - 64)
         throw Error("", "volume too large for 32-bit brick offsets");
-    v.pool.assign(size_t(next) * sizeof(T) + 64, 0);
+    resizeFreshHugePages(v.pool, size_t(next) * sizeof(T) + 64);
     T* pool = reinterpret_cast<T*>(v.pool.data());
     // Pass 2 by z-slabs of bricks, so the dense slab can be released behind us.
     for (int bz = 0; bz < v.nb[2]; ++bz) {

@@ -47,9 +47,8 @@ struct BrickedVolume {
     //    (x, y, z), y < kCells, holds the samples (x, y, z) and (x, y + 1, z), so one 32-bit
     //    (u8) or 64-bit (u16) load at (x, y, z) returns the four corners of a cell face: a
     //    trilinear sample is 2 gathers, not 4 (1.78x the pool).
-    // Built only while it stays cache-sized (<= 16 MB: faster there, slower on large
-    // volumes, where the march waits on cache misses) and the memory budget allows it;
-    // both empty otherwise, and the march reads the pool.
+    // Built up to 256 MB (buildMarchCopy: past it the memory outweighs the gain) where the
+    // memory budget allows it; both empty otherwise, and the march reads the pool.
     static constexpr int kPairRow = kEdge, kPairSlice = kEdge * kCells, kPairEntries = kPairSlice * kEdge;
     static constexpr int kQuadRow = kEdge, kQuadSlice = kEdge * kCells, kQuadEntries = kQuadSlice * kCells;
     std::vector<uint8_t> pairs, quads;
@@ -122,7 +121,7 @@ void setBrickRanges(BrickedVolume& v, size_t b, const T* s) {
 }
 
 // Builds the march's copy of v.pool for u8/u16 volumes (y-z quads for u8, y-pairs for u16
-// or where the quads would not fit) when it is at most 16 MB and the memory budget allows
+// or where the quads would not fit) when it is at most 256 MB and the memory budget allows
 // it (core/util/memory_budget.h), else leaves both empty. Returns whether one was built.
 // allowQuads = false builds y-pairs for u8 too (tests compare the layouts).
 bool buildMarchCopy(BrickedVolume& v, bool allowQuads = true);

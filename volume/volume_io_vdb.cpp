@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "core/util/error.h"
+#include "core/util/huge_pages.h"
 #include "core/util/input_file.h"
 #include "volume/vdb_file_check.h"
 #include "volume/volume_io.h"
@@ -154,7 +155,7 @@ BrickedVolume loadVDBBricked(const std::string& path, const VolumeLoadOptions& o
     const uint64_t poolFloats = (uint64_t(list.size()) + 1) * uint64_t(BrickedVolume::kBrick);
     if (poolFloats > uint64_t(std::numeric_limits<int32_t>::max()) - 64)
         throw Error(path, "too many non-empty bricks for 32-bit offsets");
-    v.pool.assign(size_t(poolFloats) * 4 + 64, 0);
+    resizeFreshHugePages(v.pool, size_t(poolFloats) * 4 + 64);
     float* pool = reinterpret_cast<float*>(v.pool.data());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size()), [&](const tbb::blocked_range<size_t>& r) {
         auto acc = grid->getConstAccessor();
