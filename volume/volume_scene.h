@@ -157,18 +157,18 @@ struct VolumeScene {
         }
         voxels = v.data<T>();
         brickStart = v.brickStart.data();
+        // the voxels the march reads: the copy where there is one (VolumeIntegrator::eval)
+        size_t marchBytes = v.pool.size();
         if (sizeof(T) < 4 && !(v.pairs.empty() && v.quads.empty())) {
             const bool quads = !v.quads.empty();
-            copyVoxels = reinterpret_cast<const T*>(quads ? v.quads.data() : v.pairs.data());
+            const std::vector<uint8_t>& copy = quads ? v.quads : v.pairs;
+            copyVoxels = reinterpret_cast<const T*>(copy.data());
             copyLayout = quads ? VoxelLayout::YZQuads : VoxelLayout::YPairs;
+            marchBytes = copy.size();
             const int entries = quads ? BrickedVolume::kQuadEntries : BrickedVolume::kPairEntries;
             copyStart.resize(v.brickStart.size());
             for (size_t i = 0; i < copyStart.size(); ++i) copyStart[i] = v.brickStart[i] / kBrick * entries;
         }
-        // the march reads the copy where there is one (VolumeIntegrator::eval)
-        const size_t marchBytes = copyLayout == VoxelLayout::YZQuads  ? v.quads.size()
-                                  : copyLayout == VoxelLayout::YPairs ? v.pairs.size()
-                                                                      : v.pool.size();
         prefetchBricks = marchBytes > kPrefetchBytes;
         nbx = v.nb[0];
         nbxy = v.nb[0] * v.nb[1];
