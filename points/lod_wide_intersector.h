@@ -6,8 +6,8 @@
 // SIMD disc test intersects the ray with the cut children's representatives (hit at
 // `repScale` of their covering radius, as the kd-tree's). The other children are visited
 // near to far. Quality 0 is full detail.
-// Packets go through the tree a native chunk of W rays at a time (traverseGroup; LoD
-// frames on ISAs narrower than 16 lanes take two or four chunks as one group of 16): the
+// Packets go through the tree a native chunk of W rays at a time (traverseGroup; ISAs
+// narrower than 16 lanes take two or four chunks as one group of 16): the
 // levels above the cut are then fetched once per group instead of once per ray, which
 // is where single rays spend their time on large clouds (dependent misses ~15 levels
 // deep). The cut stays each ray's own (its footprint at its own entry into the child's
@@ -40,9 +40,10 @@ struct LoDWideIntersector {
     // (session 20, alternating runs); the 32M LoD frames did not move.
     float singleRayFraction = 0.125f;
     float singleRayLeafFraction = 0.5f;
-    // LoD frames trace narrow chunks (AVX2 and SSE) in groups of this many lanes (4 x 4
-    // pixels): each node's frustum test, the stack and the cut decisions serve two AVX2
-    // chunks at once.
+    // Narrow chunks (AVX2 and SSE) are traced in groups of this many lanes (4 x 4 pixels):
+    // each node's frustum test, the stack and the cut decisions serve two AVX2 chunks at
+    // once. LoD frames since session 20; full detail since session 31 (2M dragon, AVX2
+    // build on Zen 5: 34-35 -> 31-33 ms a frame at one thread; 32M: 79-84 -> 75-77 ms).
     static constexpr int kGroupLanes = 16;
 
     template <bool CommonOrigin, HitData D, int N>
@@ -249,7 +250,7 @@ struct LoDWideIntersector {
                 }
             }
         };
-        if (GW > W && quality > 0.0f)
+        if constexpr (GW > W)
             run.template operator()<GW>();
         else
             run.template operator()<W>();
