@@ -72,10 +72,7 @@ struct RTfactSide {
     const Setup& s;
 
     void pixels(int x0, int y0, Packet<N>& px, Packet<N>& py) const {
-        for (int i = 0; i < N; ++i) {
-            px[i] = float(x0 + i % bw) + 0.5f;
-            py[i] = float(y0 + i / bw) + 0.5f;
-        }
+        blockPixels<N, bw>(x0, y0, 0.5f, 0.5f, px, py);
     }
     // wide: the packet's rays go one by one through the wide BVH (far views with
     // sub-pixel triangles, where packets no longer share nodes).
@@ -321,10 +318,7 @@ struct EmbreeSide {
     }
 
     static void pixels(int x0, int y0, Packet<16>& px, Packet<16>& py) {
-        for (int i = 0; i < 16; ++i) {
-            px[i] = float(x0 + i % 4) + 0.5f;
-            py[i] = float(y0 + i / 4) + 0.5f;
-        }
+        blockPixels<16, 4>(x0, y0, 0.5f, 0.5f, px, py);
     }
     void primaryTile(Frame& f, int tx, int ty) const {
         RTCIntersectContext ctx;

@@ -61,10 +61,7 @@ struct RTfactSide {
         for (int y = ty; y < std::min(ty + kTile, f.h); y += bh)
             for (int x = tx; x < std::min(tx + kTile, f.w); x += bw) {
                 Packet<N> px, py;
-                for (int i = 0; i < N; ++i) {
-                    px[i] = float(x + i % bw) + subX;
-                    py[i] = float(y + i / bw) + subY;
-                }
+                blockPixels<N, bw>(x, y, subX, subY, px, py);
                 RayPacket<N> rays;
                 cam.template generate<N>(px, py, rays);
                 const auto hit = scene.template intersect<N>(rays, Mask<N>(true));
@@ -131,10 +128,7 @@ struct EmbreeSide {
         for (int y = ty; y < std::min(ty + kTile, f.h); y += 4)
             for (int x = tx; x < std::min(tx + kTile, f.w); x += 4) {
                 Packet<16> px, py;
-                for (int i = 0; i < 16; ++i) {
-                    px[i] = float(x + i % 4) + 0.5f;
-                    py[i] = float(y + i / 4) + 0.5f;
-                }
+                blockPixels<16, 4>(x, y, 0.5f, 0.5f, px, py);
                 RayPacket<16> rays;
                 cam.generate<16>(px, py, rays);
                 alignas(64) RTCRayHit16 rh;
