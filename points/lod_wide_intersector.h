@@ -81,12 +81,14 @@ struct LoDWideIntersector {
         __builtin_prefetch(bvh.childReps[size_t(n)].radius);
     }
 
-    // A pushed entry's inner node, or its leaf's first block of discs: its turn comes later.
+    // A pushed entry's inner node, or its leaf's blocks of discs: its turn comes later.
+    // (Every block, not the first only: SAH leaves hold up to two; 2M dragon full detail
+    // about +2% on the AVX2 build, Zen 5, inside the noise of three runs.)
     static RTFACT_INLINE void prefetchEntry(const LoDWideBVH& bvh, int32_t child, int32_t count) {
         if (count == 0)
             prefetchNode(bvh, child);
         else
-            prefetchBytes(bvh.blocks.data() + child, sizeof(bvh.blocks[0]));
+            prefetchBytes(bvh.blocks.data() + child, sizeof(bvh.blocks[0]) * size_t(DiscWideBVH::blockCount(count)));
     }
 
     // The ray against the representatives of the children in `cut`; returns true when an
