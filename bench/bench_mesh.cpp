@@ -71,9 +71,7 @@ struct RTfactSide {
     const MeshScene<BVH<Triangle>>& scene;
     const Setup& s;
 
-    void pixels(int x0, int y0, Packet<N>& px, Packet<N>& py) const {
-        blockPixels<N, bw>(x0, y0, 0.5f, 0.5f, px, py);
-    }
+    void pixels(int x0, int y0, Packet<N>& px, Packet<N>& py) const { blockPixels<N, bw>(x0, y0, 0.5f, 0.5f, px, py); }
     // wide: the packet's rays go one by one through the wide BVH (far views with
     // sub-pixel triangles, where packets no longer share nodes).
     void primaryTile(Frame& f, int tx, int ty, bool wide = false) const {
