@@ -85,7 +85,9 @@ RTFACT_INLINE void splitBytes(__m512i g, simd::nvec<float, 16>& b0, simd::nvec<f
 // The 8 bytes at base + S * idx[i] per lane, lanes[0..3] into lo and lanes[4..7] into hi as
 // their 64-bit words: AVX2's 64-bit fetches (quads, TF entries) take scalar loads instead of
 // vpgatherdq. On Zen 4 (AVX2 build, tooth) the frame took 55.5 ms against 59.8 with the
-// gathers (the pairs' 32-bit gathers as scalar loads: no faster, they stay gathers).
+// gathers (the u8 pairs' 32-bit gathers as scalar loads: no faster, they stay gathers). The
+// u16 pairs' two 32-bit gathers per face as one 64-bit load per lane: 256^3 phantom 141-158
+// -> 125-146 ms, 512^3 every step 323-337 -> 295-307 ms (Zen 5, one thread, session 31).
 template <size_t S>
 RTFACT_INLINE void loadQwords8(const void* base, __m256i idx, const int (&lanes)[8], __m256i& lo, __m256i& hi) {
     alignas(32) int32_t ix[8];
@@ -171,7 +173,7 @@ RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packe
 
 // The four corners of a cell face from the y-pair layout (BrickedVolume::pairs): entry
 // idx holds (x, y), (x, y + 1), entry idx + 1 (x + 1, y), (x + 1, y + 1); one 32-bit (u8)
-// or 64-bit (u16; on AVX2 two 32-bit) gather per lane fetches both entries. a0 = (x, y), a1 = (x, y + 1),
+// or 64-bit (u16; on AVX2 a scalar 64-bit load, loadQwords8) gather per lane fetches both entries. a0 = (x, y), a1 = (x, y + 1),
 // b0 = (x + 1, y), b1 = (x + 1, y + 1).
 template <class T, int W>
 RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packet<W>& a0, Packet<W>& a1, Packet<W>& b0,
@@ -190,9 +192,13 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
             splitBytes(_mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 2), a0.c[0], a1.c[0], b0.c[0],
                        b1.c[0]);
         } else {
-            // entry idx and idx + 1 by two 32-bit gathers: no reordering of 64-bit elements
-            const __m256i ga = _mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 4);
-            const __m256i gb = _mm256_i32gather_epi32((const int*)base + 1, (__m256i)idx.c[0], 4);
+            // entries idx and idx + 1 as one 64-bit scalar load per lane (loadQwords8), sorted
+            // into the lanes' first and second entries by one in-lane shuffle each
+            __m256i qlo, qhi;
+            loadQwords8<4>(base, (__m256i)idx.c[0], {0, 1, 4, 5, 2, 3, 6, 7}, qlo, qhi);
+            const __m256 lo = _mm256_castsi256_ps(qlo), hi = _mm256_castsi256_ps(qhi);
+            const __m256i ga = _mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0x88));
+            const __m256i gb = _mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0xDD));
             const __m256i m = _mm256_set1_epi32(0xFFFF);
             a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(ga, m));
             a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(ga, 16));
