@@ -173,8 +173,8 @@ RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packe
 
 // The four corners of a cell face from the y-pair layout (BrickedVolume::pairs): entry
 // idx holds (x, y), (x, y + 1), entry idx + 1 (x + 1, y), (x + 1, y + 1); one 32-bit (u8)
-// or 64-bit (u16; on AVX2 a scalar 64-bit load, loadQwords8) gather per lane fetches both entries. a0 = (x, y), a1 = (x, y + 1),
-// b0 = (x + 1, y), b1 = (x + 1, y + 1).
+// or 64-bit (u16; on AVX2 a scalar 64-bit load, loadQwords8) gather per lane fetches both entries. a0 = (x, y), a1 =
+// (x, y + 1), b0 = (x + 1, y), b1 = (x + 1, y + 1).
 template <class T, int W>
 RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packet<W>& a0, Packet<W>& a1, Packet<W>& b0,
                              Packet<W>& b1) {
