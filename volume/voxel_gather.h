@@ -1,10 +1,11 @@
 // Fetches two x-adjacent voxels per lane with one 32-bit gather for u8/u16 storage (the
-// grid is padded so the over-read stays in bounds); f32 needs two 64-bit gathers. The
+// grid is padded so the over-read stays in bounds); f32 needs one 64-bit fetch. The
 // load method is chosen per ISA at compile time, by measurement (docs/cli.md, Volumes):
-// hardware gathers on AVX-512 and AVX2 (on Zen 5 the AVX2 build's per-lane scalar loads,
-// one int-to-float conversion and insert per voxel, took most of the march), per-lane
-// loads for narrower or scalar packets. Packets of several native chunks are fetched
-// chunk by chunk.
+// hardware gathers on AVX-512; on AVX2 hardware gathers for 32-bit elements (on Zen 5 the
+// AVX2 build's per-lane scalar loads, one int-to-float conversion and insert per voxel, took
+// most of the march) and one scalar load per lane for 64-bit ones (loadQwords8: u16 pairs,
+// f32 pairs, u8 quads, TF entries); per-lane loads for narrower or scalar packets. Packets of
+// several native chunks are fetched chunk by chunk.
 #pragma once
 #include <cstring>
 #include <type_traits>
@@ -31,18 +32,6 @@ RTFACT_INLINE void gatherEntryPairs(const void* base, simd::nvec<int32_t, 16> id
     const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
     first = _mm512_permutex2var_epi32(lo, even, hi);
     second = _mm512_permutex2var_epi32(lo, odd, hi);
-}
-#endif
-
-#if RTFACT_NATIVE_WIDTH == 8
-RTFACT_INLINE __m128i lowHalf8(simd::nvec<int32_t, 8> v) { return (__m128i)simd::lowHalf<8>(v); }
-RTFACT_INLINE __m128i highHalf8(simd::nvec<int32_t, 8> v) { return (__m128i)simd::highHalf<8>(v); }
-// Four (even, odd) float pairs from each of two 64-bit gathers -> the even and the odd floats.
-RTFACT_INLINE void splitPairs8(__m256 lo, __m256 hi, simd::nvec<float, 8>& even, simd::nvec<float, 8>& odd) {
-    const __m256i order = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
-    const __m256 l = _mm256_permutevar8x32_ps(lo, order), h = _mm256_permutevar8x32_ps(hi, order);
-    even = (simd::nvec<float, 8>)_mm256_permute2f128_ps(l, h, 0x20);
-    odd = (simd::nvec<float, 8>)_mm256_permute2f128_ps(l, h, 0x31);
 }
 #endif
 
@@ -87,7 +76,8 @@ RTFACT_INLINE void splitBytes(__m512i g, simd::nvec<float, 16>& b0, simd::nvec<f
 // vpgatherdq. On Zen 4 (AVX2 build, tooth) the frame took 55.5 ms against 59.8 with the
 // gathers (the u8 pairs' 32-bit gathers as scalar loads: no faster, they stay gathers). The
 // u16 pairs' two 32-bit gathers per face as one 64-bit load per lane: 256^3 phantom 141-158
-// -> 125-146 ms, 512^3 every step 323-337 -> 295-307 ms (Zen 5, one thread, session 31).
+// -> 125-146 ms, 512^3 every step 323-337 -> 295-307 ms; f32 pairs' vpgatherdq likewise: the
+// bonsai VDB 72-89 -> 67-78 ms (Zen 5, one thread, session 31).
 template <size_t S>
 RTFACT_INLINE void loadQwords8(const void* base, __m256i idx, const int (&lanes)[8], __m256i& lo, __m256i& hi) {
     alignas(32) int32_t ix[8];
@@ -119,11 +109,13 @@ RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packe
             a.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, m));
             b.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(g, 8 * sizeof(T)), m));
         } else {
-            const __m256 lo =
-                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, lowHalf8(idx.c[0]), 4));
-            const __m256 hi =
-                _mm256_castsi256_ps(_mm256_i32gather_epi64((const long long*)base, highHalf8(idx.c[0]), 4));
-            splitPairs8(lo, hi, a.c[0], b.c[0]);
+            // f32: the (x, x + 1) pair as one 64-bit scalar load per lane (loadQwords8), split
+            // into the lanes' first and second floats by one in-lane shuffle each
+            __m256i qlo, qhi;
+            loadQwords8<4>(base, (__m256i)idx.c[0], {0, 1, 4, 5, 2, 3, 6, 7}, qlo, qhi);
+            const __m256 lo = _mm256_castsi256_ps(qlo), hi = _mm256_castsi256_ps(qhi);
+            a.c[0] = (nvec<float, 8>)_mm256_shuffle_ps(lo, hi, 0x88);
+            b.c[0] = (nvec<float, 8>)_mm256_shuffle_ps(lo, hi, 0xDD);
         }
         return;
     }
