@@ -92,6 +92,16 @@ RTFACT_INLINE void loadQwords8(const void* base, __m256i idx, const int (&lanes)
     lo = _mm256_set_m128i(pair(2, 3), pair(0, 1));
     hi = _mm256_set_m128i(pair(6, 7), pair(4, 5));
 }
+// The 8 bytes at base + 4 idx[i] per lane split into their first and their second dword,
+// lanes in order (lanes 0, 1, 4, 5 and 2, 3, 6, 7 loaded side by side, so that one in-lane
+// shuffle each sorts them).
+RTFACT_INLINE void loadDwordPairs8(const void* base, __m256i idx, __m256i& first, __m256i& second) {
+    __m256i qlo, qhi;
+    loadQwords8<4>(base, idx, {0, 1, 4, 5, 2, 3, 6, 7}, qlo, qhi);
+    const __m256 lo = _mm256_castsi256_ps(qlo), hi = _mm256_castsi256_ps(qhi);
+    first = _mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0x88));
+    second = _mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0xDD));
+}
 #endif
 
 template <class T, int W>
@@ -109,13 +119,11 @@ RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packe
             a.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(g, m));
             b.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(g, 8 * sizeof(T)), m));
         } else {
-            // f32: the (x, x + 1) pair as one 64-bit scalar load per lane (loadQwords8), split
-            // into the lanes' first and second floats by one in-lane shuffle each
-            __m256i qlo, qhi;
-            loadQwords8<4>(base, (__m256i)idx.c[0], {0, 1, 4, 5, 2, 3, 6, 7}, qlo, qhi);
-            const __m256 lo = _mm256_castsi256_ps(qlo), hi = _mm256_castsi256_ps(qhi);
-            a.c[0] = (nvec<float, 8>)_mm256_shuffle_ps(lo, hi, 0x88);
-            b.c[0] = (nvec<float, 8>)_mm256_shuffle_ps(lo, hi, 0xDD);
+            // f32: the (x, x + 1) pair as one 64-bit scalar load per lane
+            __m256i x0, x1;
+            loadDwordPairs8(base, (__m256i)idx.c[0], x0, x1);
+            a.c[0] = (nvec<float, 8>)_mm256_castsi256_ps(x0);
+            b.c[0] = (nvec<float, 8>)_mm256_castsi256_ps(x1);
         }
         return;
     }
@@ -184,13 +192,9 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
             splitBytes(_mm256_i32gather_epi32((const int*)base, (__m256i)idx.c[0], 2), a0.c[0], a1.c[0], b0.c[0],
                        b1.c[0]);
         } else {
-            // entries idx and idx + 1 as one 64-bit scalar load per lane (loadQwords8), sorted
-            // into the lanes' first and second entries by one in-lane shuffle each
-            __m256i qlo, qhi;
-            loadQwords8<4>(base, (__m256i)idx.c[0], {0, 1, 4, 5, 2, 3, 6, 7}, qlo, qhi);
-            const __m256 lo = _mm256_castsi256_ps(qlo), hi = _mm256_castsi256_ps(qhi);
-            const __m256i ga = _mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0x88));
-            const __m256i gb = _mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0xDD));
+            // entries idx and idx + 1 as one 64-bit scalar load per lane
+            __m256i ga, gb;
+            loadDwordPairs8(base, (__m256i)idx.c[0], ga, gb);
             const __m256i m = _mm256_set1_epi32(0xFFFF);
             a0.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_and_si256(ga, m));
             a1.c[0] = (nvec<float, 8>)_mm256_cvtepi32_ps(_mm256_srli_epi32(ga, 16));
@@ -244,13 +248,10 @@ RTFACT_INLINE void fetchCube(const uint8_t* base, const Packet<W, int32_t>& idx,
     }
 #if RTFACT_NATIVE_WIDTH == 8
     if constexpr (W == 8) {
-        // Lanes 0, 1, 4, 5 in the first vector and 2, 3, 6, 7 in the second, so that one
-        // in-lane shuffle each sorts the (x, x + 1) dword pairs into x and x + 1 vectors.
-        __m256i qlo, qhi;
-        loadQwords8<4>(base, (__m256i)idx.c[0], {0, 1, 4, 5, 2, 3, 6, 7}, qlo, qhi);
-        const __m256 lo = _mm256_castsi256_ps(qlo), hi = _mm256_castsi256_ps(qhi);
-        splitBytes(_mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0x88)), a0.c[0], a1.c[0], a2.c[0], a3.c[0]);
-        splitBytes(_mm256_castps_si256(_mm256_shuffle_ps(lo, hi, 0xDD)), b0.c[0], b1.c[0], b2.c[0], b3.c[0]);
+        __m256i x0, x1;  // the quads at x and at x + 1
+        loadDwordPairs8(base, (__m256i)idx.c[0], x0, x1);
+        splitBytes(x0, a0.c[0], a1.c[0], a2.c[0], a3.c[0]);
+        splitBytes(x1, b0.c[0], b1.c[0], b2.c[0], b3.c[0]);
         return;
     }
 #endif
