@@ -72,7 +72,7 @@ RTFACT_INLINE void splitBytes(__m512i g, simd::nvec<float, 16>& b0, simd::nvec<f
 
 #if RTFACT_NATIVE_WIDTH == 8
 // The 8 bytes at base + S * idx[i] per lane, lanes[0..3] into lo and lanes[4..7] into hi as
-// their 64-bit words: AVX2's 64-bit fetches (quads, TF entries) take scalar loads instead of
+// their 64-bit words: AVX2's 64-bit fetches (quads, u16 and f32 pairs, TF entries) take scalar loads instead of
 // vpgatherdq. On Zen 4 (AVX2 build, tooth) the frame took 55.5 ms against 59.8 with the
 // gathers (the u8 pairs' 32-bit gathers as scalar loads: no faster, they stay gathers). The
 // u16 pairs' two 32-bit gathers per face as one 64-bit load per lane: 256^3 phantom 141-158
@@ -173,8 +173,8 @@ RTFACT_INLINE void fetchPair(const T* base, const Packet<W, int32_t>& idx, Packe
 
 // The four corners of a cell face from the y-pair layout (BrickedVolume::pairs): entry
 // idx holds (x, y), (x, y + 1), entry idx + 1 (x + 1, y), (x + 1, y + 1); one 32-bit (u8)
-// or 64-bit (u16; on AVX2 a scalar 64-bit load, loadQwords8) gather per lane fetches both entries. a0 = (x, y), a1 =
-// (x, y + 1), b0 = (x + 1, y), b1 = (x + 1, y + 1).
+// or 64-bit (u16; on AVX2 a scalar load, loadDwordPairs8) fetch per lane reads both
+// entries. a0 = (x, y), a1 = (x, y + 1), b0 = (x + 1, y), b1 = (x + 1, y + 1).
 template <class T, int W>
 RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packet<W>& a0, Packet<W>& a1, Packet<W>& b0,
                              Packet<W>& b1) {
@@ -234,7 +234,7 @@ RTFACT_INLINE void fetchQuad(const T* base, const Packet<W, int32_t>& idx, Packe
 // The eight corners of a cell from the y-z quad layout (BrickedVolume::quads, u8): entry
 // idx holds the samples (x, y, z), (x, y + 1, z), (x, y, z + 1), (x, y + 1, z + 1), entry
 // idx + 1 the same at x + 1: one 64-bit fetch per lane reads both (half the fetched
-// elements of the y-pairs' two 32-bit gathers; AVX2: scalar loads, loadQwords8). a_k: corner
+// elements of the y-pairs' two 32-bit gathers; AVX2: scalar loads, loadDwordPairs8). a_k: corner
 // k of x, b_k of x + 1.
 template <int W>
 RTFACT_INLINE void fetchCube(const uint8_t* base, const Packet<W, int32_t>& idx, Packet<W>& a0, Packet<W>& a1,
