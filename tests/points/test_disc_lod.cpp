@@ -421,6 +421,40 @@ TEST(LoDTree, ParallelPartitionMatchesSerial) {
             }
 }
 
+// The small-range rank sort against std::stable_sort (ties keep their input order) at
+// every size it serves, with negative, tied and signed-zero coordinates; orderedKey
+// orders like the floats.
+TEST(LoDTree, RankSortMatchesStableSort) {
+    std::mt19937 rng(46);
+    const float special[] = {-0.0f, 0.0f, -1.5f, 1.5f, -1e30f, 1e30f, 1e-40f, -1e-40f};
+    for (float a : special)
+        for (float b : special)
+            if (a < b) {
+                ASSERT_LT(orderedKey(a), orderedKey(b)) << a << " " << b;
+            }
+    for (int n = 0; n <= int(kRankSortMax); ++n)
+        for (int ties : {0, 4, 1}) {
+            std::vector<Disc> d = randomDiscs(std::max(n, 1), uint32_t(100 + n + ties));
+            d.resize(size_t(n));
+            for (size_t i = 0; i < d.size(); ++i) {
+                d[i].rgba = uint32_t(i);  // input position, to check the order of ties
+                d[i].center.z = ties ? special[rng() % uint32_t(ties)] : d[i].center.z - 0.5f;
+            }
+            std::vector<Disc> want = d, got = d;
+            std::stable_sort(want.begin(), want.end(), [](const Disc& x, const Disc& y) {
+                return orderedKey(x.center.z) < orderedKey(y.center.z);
+            });
+            if (n <= 16)
+                rankSortByCoordinate<16>(got.data(), got.size(), 2);
+            else
+                rankSortByCoordinate<int(kRankSortMax)>(got.data(), got.size(), 2);
+            for (int i = 0; i < n; ++i) {
+                ASSERT_EQ(got[size_t(i)].rgba, want[size_t(i)].rgba) << n << " " << ties << " at " << i;
+                ASSERT_EQ(got[size_t(i)].center, want[size_t(i)].center);
+            }
+        }
+}
+
 // The selection against std::nth_element: the k-th coordinate at k, nothing greater
 // before it, nothing smaller after it; the same multiset of discs; with distinct,
 // tied (few values) and all-equal coordinates, at every size class.
