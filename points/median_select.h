@@ -4,10 +4,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <vector>
 
 #include "core/util/assert.h"
@@ -81,8 +81,7 @@ inline size_t partitionBelowParallel(Disc* d, size_t n, int axis, float pivot, s
 // before +0 and NaNs at the ends, so every key has a place (float compares would let NaNs
 // share a rank).
 inline int32_t orderedKey(float f) {
-    int32_t b;
-    std::memcpy(&b, &f, 4);
+    const int32_t b = std::bit_cast<int32_t>(f);
     return b ^ ((b >> 31) & 0x7fffffff);
 }
 
@@ -92,7 +91,7 @@ inline int32_t orderedKey(float f) {
 // rank. The selection's last step on small ranges, where std::nth_element's branchy
 // partitions and insertion sort took about a fifth of the median build.
 template <int L>
-inline void rankSortByCoordinate(Disc* d, size_t n, int axis) {
+inline void rankSortLanes(Disc* d, size_t n, int axis) {
     RTFACT_ASSERT(n <= size_t(L), "rank sort: range larger than its lanes");
     alignas(64) int32_t key[L], rank[L];
     for (int i = 0; i < L; ++i) {
@@ -110,6 +109,14 @@ inline void rankSortByCoordinate(Disc* d, size_t n, int axis) {
 
 // Ranges up to this size are rank-sorted instead of partitioned further.
 constexpr size_t kRankSortMax = 32;
+
+// rankSortLanes with as few lanes as hold n <= kRankSortMax discs.
+inline void rankSortByCoordinate(Disc* d, size_t n, int axis) {
+    if (n <= 16)
+        rankSortLanes<16>(d, n, axis);
+    else
+        rankSortLanes<int(kRankSortMax)>(d, n, axis);
+}
 
 // Ranges from this size on are partitioned on several threads (the root of a LoD build:
 // before the first split nothing else can run).
@@ -153,10 +160,8 @@ inline void selectByCoordinate(Disc* d, size_t n, size_t k, int axis) {
             break;  // nothing below either pivot (ties): let std::nth_element finish
         }
     }
-    if (n <= 16)
-        rankSortByCoordinate<16>(d, n, axis);
-    else if (n <= kRankSortMax)
-        rankSortByCoordinate<int(kRankSortMax)>(d, n, axis);
+    if (n <= kRankSortMax)
+        rankSortByCoordinate(d, n, axis);
     else
         std::nth_element(d, d + k, d + n, less);
 }
