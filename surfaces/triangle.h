@@ -394,8 +394,10 @@ struct TriangleIntersector {
     }
     // One ray against L triangles given relative to the ray origin (a, b, c): the same
     // watertight edge functions as the per-triangle test; the lanes hit in (tMin, tFar).
-    // t is computed only when some lane is inside.
-    // normal() gives the triangles' faceNormal from the stored vertices.
+    // normal() gives the triangles' faceNormal from the stored vertices. The plane and t
+    // are computed whether or not some lane is inside: a branch on the edge test
+    // mispredicts on most blocks a ray hits, and costs more than the dozen operations it
+    // saves (session 33, AVX2 build on Zen 5: AO rays +8%, bounces +5%).
     template <int L, class Normal>
     static RTFACT_INLINE auto laneTest(const Vec3<L>& a, const Vec3<L>& b, const Vec3<L>& c, const Vec3<L>& d,
                                        float tMin, float tFar, Packet<L>& e0, Packet<L>& e1, Packet<L>& e2,
@@ -405,10 +407,9 @@ struct TriangleIntersector {
         e1 = dot(triangleEdge(c, a), d);
         e2 = dot(triangleEdge(a, b), d);
         const auto inside = edgesAgree(e0, e1, e2);
-        if (none(inside)) return inside;
-        // The plane only once some lane is inside (most tests end above), with the
-        // per-triangle test's values: n from the stored (not origin-relative) vertices,
-        // so t matches it bit for bit, also for grazing rays where t is ill-conditioned.
+        // The per-triangle test's values: n from the stored (not origin-relative)
+        // vertices, so t matches it bit for bit, also for grazing rays where t is
+        // ill-conditioned.
         const Vec3<L> nn = normal();
         const P nd = dot(nn, d);
         t = dot(nn, a) / nd;
