@@ -4,9 +4,11 @@
 // level-of-detail cuts: when a node's representative disc is smaller than the ray
 // footprint at its distance times `quality`, the packet intersects that disc instead of
 // descending. The footprint is the camera's cone, width(t) = base + slope * t, measured
-// from the packet's first active ray origin (exact for pinhole packets, which share it).
+// from the packet's origin (pinhole packets share one; other packets take the nearest
+// live lane's: no lane is cut coarser than alone).
 #pragma once
 #include <array>
+#include <cmath>
 
 #include "core/accel/kdtree_intersector.h"
 #include "core/concepts/camera.h"
@@ -42,14 +44,39 @@ struct LoDNodeIntersector {
         if (quality <= 0.0f) return false;
         const uint32_t idx = LoDKdTree::innerIndex(tree.nodes[node]);
         const Disc& r = inner[idx].rep;
+        auto tooLarge = [&](float dist2) {
+            const float dist = std::max(std::sqrt(dist2) - r.radius, 0.0f);
+            return 2.0f * r.radius > quality * (cone.base + cone.slope * dist);
+        };
+        // The first lane's origin first: live, its distance bounds the nearest live lane's
+        // from above (dead, it can only make the cut finer), so the other lanes need
+        // looking at only when it would cut.
         const int lane = firstChunk * Packet<N>::W;
         const Vec3f o(rays.org.x[lane], rays.org.y[lane], rays.org.z[lane]);
-        const float dist = std::max(length(r.center - o) - r.radius, 0.0f);
-        if (2.0f * r.radius > quality * (cone.base + cone.slope * dist)) return false;
+        if (tooLarge(dot(r.center - o, r.center - o))) return false;
+        if (!rays.commonOrigin && tooLarge(nearestOrigin2(r.center, rays, hit, firstChunk))) return false;
         Disc h = r;
         h.radius *= repScale;
         elem.template intersect<D>(h, uint32_t(-int32_t(idx) - 2), rays, hit, firstChunk);
         return true;
+    }
+
+    // Squared distance from c to the nearest origin of the packet's live lanes, where the
+    // cut of packets without a common origin (AO rays from hit points) is judged, so that
+    // no lane is cut coarser than it would be alone: the first lane's origin standing for
+    // all cut AO lanes across a depth edge coarse right next to their own surface, which
+    // then occluded them (black pixels, more of them the larger the packet).
+    template <int N>
+    static RTFACT_INLINE float nearestOrigin2(Vec3f c, const RayPacket<N>& rays, const Hit<N>& hit, int firstChunk) {
+        using PC = typename Packet<N>::ChunkPacket;
+        PC m(kInfinity);
+        for (int k = firstChunk; k < Packet<N>::C; ++k) {
+            const PC dx = PC(c.x) - rays.org.x.chunk(k), dy = PC(c.y) - rays.org.y.chunk(k),
+                     dz = PC(c.z) - rays.org.z.chunk(k);
+            // finished and inactive lanes carry hit.t = -inf
+            m = min(m, select(hit.t.chunk(k) > PC(-kInfinity), dx * dx + dy * dy + dz * dz, PC(kInfinity)));
+        }
+        return hmin(m);
     }
 
     template <class Tree>

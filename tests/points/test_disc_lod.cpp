@@ -183,6 +183,75 @@ TEST_P(LoDTraversal, QualityZeroEqualsBruteForce) {
 }
 INSTANTIATE_TEST_SUITE_P(LeafSizes, LoDTraversal, ::testing::Values(1, 4, 8, 16));
 
+namespace {
+
+// Rays from distinct origins (AO rays from hit points) through the LoD kd-tree, packed
+// so that every fourth lane (lane 0 among them) starts far from the sphere of discs and
+// the others just outside it, all aimed inside: lane for lane against the same ray alone.
+struct CutVsAlone {
+    int lanes = 0, aloneFull = 0, aloneRep = 0, coarser = 0;
+};
+
+template <int N>
+void checkKdCutNoCoarserThanAlone(const PointScene& scene, uint32_t seed, CutVsAlone& st) {
+    std::mt19937 g(seed);
+    for (int round = 0; round < 48; ++round) {
+        RayPacket<N> rays;
+        for (int i = 0; i < N; ++i) {
+            const Vec3f o = randomUnit(g) * (i % 4 == 0 ? 3.0f : 1.05f);
+            rays.setLane(i, o, normalize(randomUnit(g) * 0.5f - o), 0.0f, kInfinity);
+        }
+        rays.commonOrigin = false;
+        rays.finalize();
+        Mask<N> active(true);
+        for (int i = 3; i < N; i += 7) active.set(i, false);
+        const auto hit = scene.intersect<N>(rays, active);
+        for (int i = 0; i < N; ++i) {
+            if (!active[i]) continue;
+            const auto one = scene.intersect<1>(rays.lane(i), Mask<1>(true));
+            ++st.lanes;
+            if (int32_t(one.id[0]) >= 0) {
+                ++st.aloneFull;
+                st.coarser += hit.id[i] <= -2;
+            } else if (int32_t(one.id[0]) <= -2) {
+                ++st.aloneRep;
+            }
+        }
+    }
+}
+
+}  // namespace
+
+// A packet without a common origin is cut where its nearest live lane would be, so no
+// lane gets a representative where alone it sees full detail. (The first lane's origin
+// used to stand for the packet: the near lanes then hit coarse representatives right in
+// front of them, the black pixels AO images of scans had at depth edges, more of them the
+// larger the packet.)
+TEST(LoDTraversal, DistinctOriginsAreNeverCutCoarserThanAlone) {
+    std::vector<Disc> sphere = randomDiscs(20000, 81);
+    std::mt19937 g(82);
+    for (Disc& d : sphere) {
+        d.center = randomUnit(g);
+        d.normal = encodeNormal(d.center);
+        d.radius = 0.03f;
+    }
+    PointScene scene;
+    scene.accel = PointAccel::KdTree;
+    scene.build(sphere);
+    // cut where r <= 0.1 dist: near lanes (~0.05 away) see full detail, far ones (~2) not
+    scene.setLoD(RayCone{0.0f, 0.05f}, 4.0f);
+    CutVsAlone st;
+    checkKdCutNoCoarserThanAlone<simd::kNativeWidth>(scene, 83, st);
+    checkKdCutNoCoarserThanAlone<16>(scene, 84, st);
+    checkKdCutNoCoarserThanAlone<64>(scene, 85, st);
+    checkKdCutNoCoarserThanAlone<256>(scene, 86, st);
+    EXPECT_GT(st.aloneFull, st.lanes / 2) << "the near lanes must see full detail alone";
+    EXPECT_GT(st.aloneRep, st.lanes / 10) << "the far lanes must be cut alone";
+    // Only a representative reaching outside its box may come first in another visiting
+    // order: at most 0.5% of the lanes.
+    EXPECT_LE(st.coarser, st.aloneFull / 200) << st.coarser << " of " << st.aloneFull;
+}
+
 // Full detail through the wide BVH of disc blocks (PointAccel::Wide): the same
 // hits as brute force at every packet width.
 TEST(DiscWideBVH, FullDetailEqualsBruteForce) {
