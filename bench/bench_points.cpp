@@ -340,7 +340,7 @@ int benchPoints(int argc, char** argv) {
     std::string file, eye, at, up, size = "1024x1024", normals = "auto", accel = "kd", split = "sah";
     float fov = 45.0f, radius = 0.0f, radiusFactor = 1.0f;
     std::vector<float> quality{1.0f}, repScale{0.7f};
-    int threads = 0, packet = 16, repeat = 3, leafSize = 8;
+    int threads = 0, packet = engine::defaultPacketSize(engine::SceneKind::Points), repeat = 3, leafSize = 8;
     bool lodOnly = false;
     app.add_option("FILE", file, "Point cloud (.ply .pcd .xyz .pts)")->required();
     app.add_option("--eye", eye, "Camera position x,y,z");

@@ -57,7 +57,11 @@ void applyEyeDomeLighting(Frame& frame, float strength) {
     ::rtfact::applyEyeDomeLighting(frame.rgba, frame.depth, frame.width, frame.height, strength);
 }
 
-int defaultPacketSize(SceneKind kind) { return kind == SceneKind::Points ? 16 : 64; }
+// 64 rays (8 x 8 pixels) for every kind. Point clouds had 16 since the first LoD kd-tree;
+// since the packet traversals share their top levels and trace in 4 x 4 tiles, 64 renders
+// the scans 20-40% faster at one thread (kd-tree, eyelight and AO, both ISAs; the wide BVH
+// a few percent), with the same images (docs/benchmarks.md, session 35).
+int defaultPacketSize(SceneKind) { return 64; }
 
 CameraFrame fitCamera(const DefaultView& view, float fovDeg, float aspect) {
     return ::rtfact::fitCamera(view.focus, fovDeg, aspect, view.viewDir, view.up);

@@ -37,8 +37,7 @@ struct FrameOptions {
     bool depth = false;
 };
 
-// Rays per packet that measured best for each kind (sub-pixel splats make wide point
-// packets incoherent: 16; bench/bench_points.cpp).
+// Rays per packet that measured best for each kind (64 for all: render_session.cpp).
 int defaultPacketSize(SceneKind kind);
 
 // The default camera for a view: the whole focus box in sight.
