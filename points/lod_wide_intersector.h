@@ -229,14 +229,21 @@ struct LoDWideIntersector {
         if constexpr (Packet<N>::W < 4) {
             BitMask<N>(active).forEach([&](int i) { singleLane<D, AnyHit>(bvh, rays, hit, i, 0); });
         } else {
-            traceInChunkTiles(
+            traceInChunkTiles<groupLanes<N>()>(
                 rays, hit, [&](const RayPacket<N>& r, Hit<N>& h) { traceChunks<CommonOrigin, D, AnyHit>(bvh, r, h); });
         }
     }
 
+    // Lanes traced together: a native chunk, or narrow ones in groups of kGroupLanes.
+    template <int N>
+    static constexpr int groupLanes() {
+        constexpr int W = Packet<N>::W;
+        return kGroupLanes <= N && W < kGroupLanes ? kGroupLanes : W;
+    }
+
     template <bool CommonOrigin, HitData D, bool AnyHit, int N>
     void traceChunks(const LoDWideBVH& bvh, const RayPacket<N>& rays, Hit<N>& hit) const {
-        constexpr int W = Packet<N>::W, GW = kGroupLanes <= N && W < kGroupLanes ? kGroupLanes : W;
+        constexpr int W = Packet<N>::W, GW = groupLanes<N>();
         const BitMask<N> bits(hit.t > Packet<N>(-kInfinity));
         auto run = [&]<int M>() __attribute__((always_inline)) {
             for (int g = 0; g < N / M; ++g) {

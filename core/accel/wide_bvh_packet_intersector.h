@@ -94,9 +94,12 @@ struct WideFrustum {
 // image. Packets from the renderer are bw x bh pixels in row-major order (bw the
 // smallest divisor of N with bw * bw >= N, core/render's packetBlockWidth), so W
 // consecutive lanes would be a thin strip (16 x 1 pixels for 256 rays on AVX-512);
-// cw x ch tiles cross fewer small nodes. Only speed depends on it: any packet is
+// cw x ch tiles cross fewer small nodes. A traversal that takes G > W lanes (consecutive
+// chunks) through the tree as one group gets compact groups too: the group's chunk tiles
+// stacked into a 4 x (G / 4) tile (AVX2 chunks of 4 x 2 in 4 x 4 groups; rows of 4 x 2
+// tiles paired side by side made 8 x 2 groups). Only speed depends on it: any packet is
 // traced correctly in any order. perm[i] is the packet lane that regrouped lane i holds.
-template <int N>
+template <int N, int G = Packet<N>::W>
 struct PacketChunkTiles {
     static constexpr int W = Packet<N>::W;
     static constexpr int bw = [] {
@@ -106,34 +109,40 @@ struct PacketChunkTiles {
     }();
     static constexpr int bh = N / bw;
     static constexpr int cw = W >= 8 ? 4 : 2, ch = W / cw;
-    static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % ch == 0;
+    // lanes a group (groups of chunks only where chunk tiles are 4 wide), its tile
+    static constexpr int GL = G > W&& cw == 4 && G % W == 0 ? G : W;
+    static constexpr int gw = cw, gh = GL / gw;
+    static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % gh == 0 && N % GL == 0;
+    static constexpr int groupsX = bw / gw;
     static constexpr std::array<int16_t, N> perm = [] {
         std::array<int16_t, N> p{};
-        const int tilesX = bw / cw;
         for (int i = 0; i < N; ++i) {
-            const int tile = i / W, l = i % W;
-            const int x = (tile % tilesX) * cw + l % cw, y = (tile / tilesX) * ch + l / cw;
+            const int group = i / GL, l = i % GL;
+            const int x = (group % groupsX) * gw + l % gw, y = (group / groupsX) * gh + l / gw;
             p[size_t(i)] = int16_t(y * bw + x);
         }
         return p;
     }();
+    // The packet lane of the first lane of row y of chunk c's tile.
+    static constexpr int rowStart(int c, int y) {
+        const int group = c / (GL / W), q = c % (GL / W);
+        return ((group / groupsX) * gh + q * ch + y) * bw + (group % groupsX) * gw;
+    }
 };
 
-// Runs trace(r, h) on the packet regrouped in PacketChunkTiles order when the packet has
-// one (else on the packet as it is), then puts the hit records back in the packet's lane
-// order. h starts with hit.t and id -1.
-template <int N, class Hit, class Trace>
+// Runs trace(r, h) on the packet regrouped in PacketChunkTiles order (groups of G lanes;
+// 0: single chunks) when the packet has one (else on the packet as it is), then puts the
+// hit records back in the packet's lane order. h starts with hit.t and id -1.
+template <int G = 0, int N, class Hit, class Trace>
 void traceInChunkTiles(const RayPacket<N>& rays, Hit& hit, const Trace& trace) {
-    using T = PacketChunkTiles<N>;
+    using T = PacketChunkTiles<N, (G > 0 ? G : Packet<N>::W)>;
     if constexpr (T::kEnabled) {
         // A tile row is cw consecutive lanes on both sides: the regrouping moves whole
         // rows (one 16-byte copy each) instead of single lanes.
         constexpr int kRow = T::cw * 4;
         auto rows = [](auto&& copy) __attribute__((always_inline)) {
-            constexpr int tilesX = T::bw / T::cw;
             for (int tile = 0; tile < N / T::W; ++tile)
-                for (int y = 0; y < T::ch; ++y)
-                    copy(tile * T::W + y * T::cw, ((tile / tilesX) * T::ch + y) * T::bw + (tile % tilesX) * T::cw);
+                for (int y = 0; y < T::ch; ++y) copy(tile * T::W + y * T::cw, T::rowStart(tile, y));
         };
         RayPacket<N> r;
         Hit h;

@@ -214,23 +214,39 @@ TEST(WideBVHPacket, EmptyAndSingleTriangle) {
 }
 
 // The tiled lane order is a permutation, and a chunk is a compact tile of the packet's
-// row-major bw x bh pixels (not a strip of one row).
-template <int N>
+// row-major bw x bh pixels (not a strip of one row); so is a group of G lanes traced
+// together (the LoD wide BVH's 16-lane groups of AVX2 chunks: 4 x 4, not 8 x 2), and the
+// rows traceInChunkTiles copies are the permutation's.
+template <int N, int G = Packet<N>::W>
 void checkChunkTiles() {
-    using T = WideBVHPacketIntersector<TriangleIntersector>::ChunkTiles<N>;
+    using T = PacketChunkTiles<N, G>;
     if constexpr (T::kEnabled) {
         std::vector<int> seen(static_cast<size_t>(N), 0);
         for (int i = 0; i < N; ++i) ++seen[size_t(T::perm[size_t(i)])];
         EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), N);
-        for (int k = 0; k < N / T::W; ++k) {
+        auto extent = [](int first, int lanes, int& w, int& h) {
             int x0 = N, x1 = -1, y0 = N, y1 = -1;
-            for (int l = 0; l < T::W; ++l) {
-                const int p = T::perm[size_t(k * T::W + l)];
+            for (int l = 0; l < lanes; ++l) {
+                const int p = T::perm[size_t(first + l)];
                 x0 = std::min(x0, p % T::bw), x1 = std::max(x1, p % T::bw);
                 y0 = std::min(y0, p / T::bw), y1 = std::max(y1, p / T::bw);
             }
-            EXPECT_EQ(x1 - x0 + 1, T::cw) << "chunk " << k;
-            EXPECT_EQ(y1 - y0 + 1, T::ch) << "chunk " << k;
+            w = x1 - x0 + 1, h = y1 - y0 + 1;
+        };
+        for (int k = 0; k < N / T::W; ++k) {
+            int w, h;
+            extent(k * T::W, T::W, w, h);
+            EXPECT_EQ(w, T::cw) << "chunk " << k;
+            EXPECT_EQ(h, T::ch) << "chunk " << k;
+            for (int y = 0; y < T::ch; ++y)
+                for (int x = 0; x < T::cw; ++x)
+                    EXPECT_EQ(T::perm[size_t(k * T::W + y * T::cw + x)], T::rowStart(k, y) + x) << "chunk " << k;
+        }
+        for (int g = 0; g < N / T::GL; ++g) {
+            int w, h;
+            extent(g * T::GL, T::GL, w, h);
+            EXPECT_EQ(w * h, T::GL) << "group " << g;
+            EXPECT_LE(std::max(w, h), 4 * std::min(w, h)) << "group " << g;
         }
     }
 }
@@ -238,4 +254,9 @@ TEST(WideBVHPacket, ChunkTiles) {
     EXPECT_TRUE((WideBVHPacketIntersector<TriangleIntersector>::ChunkTiles<256>::kEnabled));
     checkChunkTiles<64>();
     checkChunkTiles<256>();
+    checkChunkTiles<64, 16>();
+    checkChunkTiles<256, 16>();
+    if constexpr (simd::kNativeWidth == 8) {
+        static_assert(PacketChunkTiles<64, 16>::gw == 4 && PacketChunkTiles<64, 16>::gh == 4);
+    }
 }
