@@ -121,6 +121,19 @@ std::vector<Disc> randomDiscs(int n, uint32_t seed) {
     return d;
 }
 
+// n discs of radius r on the unit sphere, facing outwards (randomDiscs' colours), as scans
+// are closed surfaces of overlapping discs.
+std::vector<Disc> sphereDiscs(int n, uint32_t seed, float r) {
+    std::vector<Disc> sphere = randomDiscs(n, seed);
+    std::mt19937 g(seed + 1);
+    for (Disc& d : sphere) {
+        d.center = randomUnit(g);
+        d.normal = encodeNormal(d.center);
+        d.radius = r;
+    }
+    return sphere;
+}
+
 template <int N>
 void checkAgainstBruteForce(const PointScene& scene, bool commonOrigin, uint32_t seed) {
     std::mt19937 g(seed);
@@ -228,16 +241,9 @@ void checkKdCutNoCoarserThanAlone(const PointScene& scene, uint32_t seed, CutVsA
 // front of them, the black pixels AO images of scans had at depth edges, more of them the
 // larger the packet.)
 TEST(LoDTraversal, DistinctOriginsAreNeverCutCoarserThanAlone) {
-    std::vector<Disc> sphere = randomDiscs(20000, 81);
-    std::mt19937 g(82);
-    for (Disc& d : sphere) {
-        d.center = randomUnit(g);
-        d.normal = encodeNormal(d.center);
-        d.radius = 0.03f;
-    }
     PointScene scene;
     scene.accel = PointAccel::KdTree;
-    scene.build(sphere);
+    scene.build(sphereDiscs(20000, 81, 0.03f));
     // cut where r <= 0.1 dist: near lanes (~0.05 away) see full detail, far ones (~2) not
     scene.setLoD(RayCone{0.0f, 0.05f}, 4.0f);
     CutVsAlone st;
@@ -628,14 +634,7 @@ TEST(LoDTree, CoarseQualityAnswersWithRepresentatives) {
     EXPECT_GT(vol.sameSubtree, 0);
     // A closed surface, as scans are (discs on the unit sphere overlapping their
     // neighbours): a representative stands for the surface where full detail finds it.
-    std::vector<Disc> sphere = randomDiscs(4000, 42);
-    std::mt19937 g(43);
-    for (Disc& d : sphere) {
-        d.center = randomUnit(g);
-        d.normal = encodeNormal(d.center);
-        d.radius = 0.06f;
-    }
-    const RepHitStats surf = checkRepresentativeHits(sphere);
+    const RepHitStats surf = checkRepresentativeHits(sphereDiscs(4000, 42, 0.06f));
     EXPECT_GT(surf.repHits, 100);
     EXPECT_GE(surf.fullHits, surf.repHits * 9 / 10) << "representatives where full detail sees nothing";
     // Measured 237 of 246: the others see through a gap between representatives.
@@ -685,19 +684,12 @@ RayPacket<N> cameraPacket(const PinholeCamera& cam, int first, bool commonOrigin
     return rays;
 }
 
-// n discs of radius r on the unit sphere, facing outwards, in a wide BVH.
+// sphereDiscs in a wide BVH.
 PointScene wideSphere(int n, uint32_t seed, float r, LoDWideSplit split) {
-    std::vector<Disc> sphere = randomDiscs(n, seed);
-    std::mt19937 g(seed + 1);
-    for (Disc& d : sphere) {
-        d.center = randomUnit(g);
-        d.normal = encodeNormal(d.center);
-        d.radius = r;
-    }
     PointScene scene;
     scene.accel = PointAccel::Wide;
     scene.wideSplit = split;
-    scene.build(sphere);
+    scene.build(sphereDiscs(n, seed, r));
     return scene;
 }
 
