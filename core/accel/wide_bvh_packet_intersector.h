@@ -112,7 +112,7 @@ struct PacketChunkTiles {
     // lanes a group (groups of chunks only where chunk tiles are 4 wide), its tile
     static constexpr int GL = G > W&& cw == 4 && G % W == 0 ? G : W;
     static constexpr int gw = cw, gh = GL / gw;
-    static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % gh == 0 && N % GL == 0;
+    static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % gh == 0;
     static constexpr int groupsX = bw / gw;
     static constexpr std::array<int16_t, N> perm = [] {
         std::array<int16_t, N> p{};
@@ -123,11 +123,9 @@ struct PacketChunkTiles {
         }
         return p;
     }();
-    // The packet lane of the first lane of row y of chunk c's tile.
-    static constexpr int rowStart(int c, int y) {
-        const int group = c / (GL / W), q = c % (GL / W);
-        return ((group / groupsX) * gh + q * ch + y) * bw + (group % groupsX) * gw;
-    }
+    // The packet lane of the first lane of row y of chunk c's tile (a row is cw lanes
+    // that are consecutive on both sides).
+    static constexpr int rowStart(int c, int y) { return perm[size_t(c * W + y * cw)]; }
 };
 
 // Runs trace(r, h) on the packet regrouped in PacketChunkTiles order (groups of G lanes;
@@ -135,7 +133,7 @@ struct PacketChunkTiles {
 // hit records back in the packet's lane order. h starts with hit.t and id -1.
 template <int G = 0, int N, class Hit, class Trace>
 void traceInChunkTiles(const RayPacket<N>& rays, Hit& hit, const Trace& trace) {
-    using T = PacketChunkTiles<N, (G > 0 ? G : Packet<N>::W)>;
+    using T = PacketChunkTiles<N, G>;
     if constexpr (T::kEnabled) {
         // A tile row is cw consecutive lanes on both sides: the regrouping moves whole
         // rows (one 16-byte copy each) instead of single lanes.
