@@ -111,14 +111,14 @@ struct PacketChunkTiles {
     static constexpr int cw = W >= 8 ? 4 : 2, ch = W / cw;
     // lanes a group (groups of chunks only where chunk tiles are 4 wide), its tile
     static constexpr int GL = G > W&& cw == 4 && G % W == 0 ? G : W;
-    static constexpr int gw = cw, gh = GL / gw;
+    static constexpr int gh = GL / cw;
     static constexpr bool kEnabled = N > W&& W >= 4 && bw > cw&& bw % cw == 0 && bh % gh == 0;
-    static constexpr int groupsX = bw / gw;
+    static constexpr int groupsX = bw / cw;
     static constexpr std::array<int16_t, N> perm = [] {
         std::array<int16_t, N> p{};
         for (int i = 0; i < N; ++i) {
             const int group = i / GL, l = i % GL;
-            const int x = (group % groupsX) * gw + l % gw, y = (group / groupsX) * gh + l / gw;
+            const int x = (group % groupsX) * cw + l % cw, y = (group / groupsX) * gh + l / cw;
             p[size_t(i)] = int16_t(y * bw + x);
         }
         return p;

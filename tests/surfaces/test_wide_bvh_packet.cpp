@@ -257,6 +257,6 @@ TEST(WideBVHPacket, ChunkTiles) {
     checkChunkTiles<64, 16>();
     checkChunkTiles<256, 16>();
     if constexpr (simd::kNativeWidth == 8) {
-        static_assert(PacketChunkTiles<64, 16>::gw == 4 && PacketChunkTiles<64, 16>::gh == 4);
+        static_assert(PacketChunkTiles<64, 16>::cw == 4 && PacketChunkTiles<64, 16>::gh == 4);
     }
 }
