@@ -368,7 +368,8 @@ int benchPoints(int argc, char** argv) {
     app.add_option("--packet", packet, "RTfact packet size: 1, 16, 64 or 256")
         ->capture_default_str()
         ->check(CLI::IsMember({1, 16, 64, 256}));
-    app.add_option("--repeat", repeat, "Runs per measurement (best is kept)")
+    app.add_option("--repeat", repeat,
+                   "Runs per frame measurement (best is kept; builds always run twice, first and best printed)")
         ->capture_default_str()
         ->check(CLI::Range(1, 100));
     app.add_option("--lod-quality", quality, "LoD quality for the LoD run (more values: extra LoD runs at all threads)")
