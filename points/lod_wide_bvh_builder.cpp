@@ -8,10 +8,10 @@
 #include "core/accel/wide_bvh_builder.h"
 #include "core/util/assert.h"
 #include "core/util/error.h"
-#include "points/centre_bounds.h"
 #include "points/lod_rep.h"
 #include "points/lod_wide_bvh.h"
 #include "points/median_select.h"
+#include "points/spread_axis.h"
 
 namespace rtfact::points {
 
@@ -108,23 +108,15 @@ int planStep(const Plan& p, uint32_t f, uint32_t c) {
     return -1;
 }
 
-// Applies the plan's steps inside d[f, f + c) (bounds of its centres: `box`), storing
-// each final part's cell. Sibling ranges are disjoint, so the discs end in the same
-// order as a serial replay of the steps.
-void splitRange(const Plan& p, Disc* d, uint32_t f, uint32_t c, const AABB& box, AABB* cell) {
+// Applies the plan's steps inside d[f, f + c). Sibling ranges are disjoint, so the discs
+// end in the same order as a serial replay of the steps.
+void splitRange(const Plan& p, Disc* d, uint32_t f, uint32_t c) {
     const int s = planStep(p, f, c);
-    if (s < 0) {
-        for (int i = 0; i < p.parts; ++i)
-            if (p.first[i] == f) cell[i] = box;
-        return;
-    }
+    if (s < 0) return;
     const uint32_t h = p.half[s];
-    const int axis = box.maxAxis();
-    selectMedianByCoordinate(d + f, c, h, axis);
-    AABB lo = box, hi = box;
-    lo.hi[axis] = hi.lo[axis] = d[f + h].center[axis];
-    auto left = [&] { splitRange(p, d, f, h, lo, cell); };
-    auto right = [&] { splitRange(p, d, f + h, c - h, hi, cell); };
+    selectMedianByCoordinate(d + f, c, h, spreadAxis(d + f, c));
+    auto left = [&] { splitRange(p, d, f, h); };
+    auto right = [&] { splitRange(p, d, f + h, c - h); };
     if (c >= (1u << 18)) {
         tbb::parallel_invoke(left, right);
     } else {
@@ -133,18 +125,17 @@ void splitRange(const Plan& p, Disc* d, uint32_t f, uint32_t c, const AABB& box,
     }
 }
 
-// Node `ni` over elems[first, first + count) (cell: bounds of the centres): median splits
-// of the longest cell axis as planned, children built (the large ones in parallel), their
+// Node `ni` over elems[first, first + count): median splits along the axis of widest
+// spread as planned, children built (the large ones in parallel), their
 // boxes and representatives stored in the node; returns the node's sum. Subtrees take
 // the slots after their parent, depth first.
-Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, const AABB& rootCell, int depth) {
+Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, int depth) {
     LoDWideBVH& t = *ctx.t;
     RTFACT_ASSERT(depth < LoDWideBVH::kMaxDepth, "wide LoD tree deeper than its traversal stack");
     const Plan p = makePlan(count);
     // Replay the plan on the discs: each step selects the median of one range; the
     // halves of a step are independent, so large ones are split in parallel.
-    AABB cell[K];
-    splitRange(p, t.elems.data() + first, 0, count, rootCell, cell);
+    splitRange(p, t.elems.data() + first, 0, count);
     // Slots: children's subtrees follow this node in part order.
     uint32_t slot[K];
     uint32_t next = ni + 1;
@@ -157,7 +148,7 @@ Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, const AABB&
         if (p.count[i] <= uint32_t(S))
             kids[i] = leafBlock(t, first + p.first[i], p.count[i]);
         else
-            kids[i] = buildNode(ctx, slot[i], first + p.first[i], p.count[i], cell[i], depth + 1);
+            kids[i] = buildNode(ctx, slot[i], first + p.first[i], p.count[i], depth + 1);
     };
     if (count >= 32768)
         tbb::parallel_for(0, p.parts, child);
@@ -289,9 +280,8 @@ LoDWideBVH buildLoDWideBVH(std::vector<Disc> discs, LoDWideSplit split) {
     resizeFreshHugePages(t.childReps, nodes);
     resizeFreshHugePages(t.reps, size_t(nodes) * K);
     resizeHugePages(t.blocks, (n + S - 1) / S);
-    const AABB cell = centreBounds(t.elems);
     Ctx ctx{&t, &counts};
-    const Sum root = buildNode(ctx, 0, 0, n, cell, 0);
+    const Sum root = buildNode(ctx, 0, 0, n, 0);
     t.box = root.s.box;
     return t;
 }

@@ -14,6 +14,7 @@
 #include "points/median_select.h"
 #include "points/point_prepare.h"
 #include "points/point_scene.h"
+#include "points/spread_axis.h"
 
 using namespace rtfact;
 using namespace rtfact::points;
@@ -552,6 +553,32 @@ TEST(LoDTree, SelectByCoordinateMatchesNthElement) {
                 ASSERT_EQ(sortedKeys(a), sortedKeys(d));
             }
         }
+}
+
+// The median splits' axis: the widest spread of the range's own centres (exact up to
+// kSpreadAxisSamples discs, from evenly strided ones beyond), whatever the order.
+TEST(LoDTree, SpreadAxisIsTheRangesWidestSpread) {
+    std::mt19937 rng(46);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int axis = 0; axis < 3; ++axis)
+        for (size_t n : {size_t(2), size_t(50), kSpreadAxisSamples, size_t(100000)}) {
+            // a slab: 10 wide along `axis`, 1 and 0.1 along the others
+            std::vector<Disc> d(n);
+            for (Disc& x : d)
+                for (int a = 0; a < 3; ++a)
+                    x.center[a] = u(rng) * (a == axis ? 10.0f : a == (axis + 1) % 3 ? 1.0f : 0.1f);
+            // two discs at the wide axis' ends, the rest in the middle: small ranges see them
+            if (n <= kSpreadAxisSamples) {
+                for (Disc& x : d) x.center[axis] = 5.0f;
+                d.front().center[axis] = 0.0f;
+                d.back().center[axis] = 10.0f;
+            }
+            EXPECT_EQ(spreadAxis(d.data(), d.size()), axis) << n;
+        }
+    // one disc: no spread, any axis in range
+    const Disc one{};
+    const int a = spreadAxis(&one, 1);
+    EXPECT_TRUE(a >= 0 && a < 3);
 }
 
 namespace {
