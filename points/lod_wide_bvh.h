@@ -38,11 +38,11 @@ struct LoDWideBVH : DiscWideBVH {
 // How the tree is split. Sah: the core's wide SAH builder (core/accel/wide_bvh_builder.h)
 // on the discs' tight bounds, leaves of up to two blocks: the faster tree to trace.
 // Median: top-down median splits along the axis the range's centres spread most along
-// (selection, not sorting), up to four levels per wide node, into complete subtrees of 8 * 16^j discs
-// and one rest, so that nodes are full (~1 node per 15 blocks) and every leaf is one full
-// block of discs adjacent in memory, subtrees in parallel and depth first: a 5-6x faster
-// build (rtfact-bench points --wide-split compares them). Representatives bottom-up
-// either way.
+// (points/spread_axis.h; selection, not sorting), up to four levels per wide node, into
+// complete subtrees of 8 * 16^j discs and one rest, so that nodes are full (~1 node per 15
+// blocks) and every leaf is one full block of discs adjacent in memory, subtrees in
+// parallel and depth first: a 5-6x faster build (rtfact-bench points --wide-split compares
+// them). Representatives bottom-up either way.
 enum class LoDWideSplit { Sah, Median };
 
 LoDWideBVH buildLoDWideBVH(std::vector<Disc> discs, LoDWideSplit split = LoDWideSplit::Sah);

@@ -126,9 +126,9 @@ void splitRange(const Plan& p, Disc* d, uint32_t f, uint32_t c) {
 }
 
 // Node `ni` over elems[first, first + count): median splits along the axis of widest
-// spread as planned, children built (the large ones in parallel), their
-// boxes and representatives stored in the node; returns the node's sum. Subtrees take
-// the slots after their parent, depth first.
+// spread as planned, children built (the large ones in parallel), their boxes and
+// representatives stored in the node; returns the node's sum. Subtrees take the slots
+// after their parent, depth first.
 Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, int depth) {
     LoDWideBVH& t = *ctx.t;
     RTFACT_ASSERT(depth < LoDWideBVH::kMaxDepth, "wide LoD tree deeper than its traversal stack");
