@@ -44,8 +44,9 @@ struct LoDKdTree : KdTree<Disc> {
     double bytesPerPoint() const { return elems.empty() ? 0.0 : double(memoryBytes()) / double(elems.size()); }
 };
 
-// Median split of the longest axis of the centres' cell, subtrees built in parallel
-// (TBB); node slots are computed up front so that threads write disjoint ranges.
+// Median split along the axis the centres spread most along (points/spread_axis.h),
+// subtrees built in parallel (TBB); node slots are computed up front so that threads write
+// disjoint ranges.
 struct LoDKdTreeBuilder {
     int maxLeafSize = 8;
     LoDKdTree build(std::vector<Disc> discs) const;

@@ -6,10 +6,10 @@
 
 #include "core/util/error.h"
 #include "core/util/huge_pages.h"
-#include "points/centre_bounds.h"
 #include "points/lod_kdtree.h"
 #include "points/lod_rep.h"
 #include "points/median_select.h"
+#include "points/spread_axis.h"
 
 namespace rtfact::points {
 
@@ -53,7 +53,7 @@ void quantiseChildBox(LoDInner& in, int child, const AABB& b) {
     }
 }
 
-Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t next) {
+Agg buildNode(Ctx& ctx, Disc* d, size_t n, uint32_t slot, uint32_t next) {
     LoDKdTree& t = *ctx.tree;
     Agg a;
     if (n <= ctx.leafSize) {
@@ -67,19 +67,16 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, AABB cell, uint32_t slot, uint32_t ne
         a.rep = rep;
         return a;
     }
-    const int axis = cell.maxAxis();
+    const int axis = spreadAxis(d, n);
     const size_t half = n / 2;
     selectMedianByCoordinate(d, n, half, axis);
     const float split = d[half].center[axis];
-    AABB lcell = cell, rcell = cell;
-    lcell.hi[axis] = split;
-    rcell.lo[axis] = split;
     const uint32_t left = next;
     t.nodes[slot] = KdNode::inner(axis, split, left);
     const uint32_t lnext = next + 2, rnext = lnext + ctx.descendants(half);
     Agg la, ra;
-    auto bl = [&] { la = buildNode(ctx, d, half, lcell, left, lnext); };
-    auto br = [&] { ra = buildNode(ctx, d + half, n - half, rcell, left + 1, rnext); };
+    auto bl = [&] { la = buildNode(ctx, d, half, left, lnext); };
+    auto br = [&] { ra = buildNode(ctx, d + half, n - half, left + 1, rnext); };
     if (n >= 8192)
         tbb::parallel_invoke(bl, br);
     else {
@@ -114,7 +111,7 @@ LoDKdTree LoDKdTreeBuilder::build(std::vector<Disc> discs) const {
     const uint32_t total = 1 + ctx.computeDesc(discs.size());
     resizeFreshHugePages(t.nodes, total);
     resizeFreshHugePages(t.inner, (total - 1) / 2);
-    const Agg a = buildNode(ctx, discs.data(), discs.size(), centreBounds(discs), 0, 1);
+    const Agg a = buildNode(ctx, discs.data(), discs.size(), 0, 1);
     t.box = a.s.box;
     const Vec3f pad = Vec3f(1e-6f * (maxComponent(vmax(-a.s.box.lo, a.s.box.hi)) + maxComponent(a.s.box.extent())));
     t.box.lo -= pad;
