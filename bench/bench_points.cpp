@@ -248,7 +248,16 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
     // of it faults in the host: ~2 s per GiB there against 0.1 s for memory touched again at
     // once (docs/benchmarks.md, session 37), which the 32M cloud's 1.4 GB of tree pays.
     constexpr int kBuilds = 2;
-    double rtBuild = 1e30, rtCpu = 1e30, rtFirst = 0;
+    struct BuildTimes {
+        double first = 0, best = 1e30;
+        int count = 0;
+        void add(double ms) {
+            if (count++ == 0) first = ms;
+            best = std::min(best, ms);
+        }
+    };
+    BuildTimes rtTimes;
+    double rtCpu = 1e30;
     {
         // Build at all threads (the target is points/s on all cores).
         tbb::task_arena arena(all);
@@ -262,36 +271,31 @@ int run(const std::string& file, std::shared_ptr<PointScene> built, const Pinhol
             const auto t0 = Clock::now();
             const double c0 = processCpuMs();
             arena.execute([&] { rebuilt.build(std::move(copy), builder); });
-            const double ms = msSince(t0);
-            if (r == 0) rtFirst = ms;
-            rtBuild = std::min(rtBuild, ms);
+            rtTimes.add(msSince(t0));
             rtCpu = std::min(rtCpu, processCpuMs() - c0);
         }
     }
     // Embree gets the same discs in the same (leaf) order.
     EmbreeSide em(discs, cam, all);
-    double emBuild = 1e30, emCpu = 1e30, emFirst = 0;
+    BuildTimes emTimes;
+    double emCpu = 1e30;
     {
         tbb::task_arena arena(all);
         for (int r = 0; r < kBuilds; ++r) {
             const double c0 = processCpuMs();
-            arena.execute([&] {
-                const double ms = em.build();
-                if (r == 0) emFirst = ms;
-                emBuild = std::min(emBuild, ms);
-            });
+            arena.execute([&] { emTimes.add(em.build()); });
             emCpu = std::min(emCpu, processCpuMs() - c0);
         }
     }
     const double rtBytes = double(scene.memoryBytes());
     // Embree keeps its own copy of the points (16 B centre+radius, 12 B normal) plus the BVH.
     const double emBytes = double(gEmbreeBytes.load()) + double(n) * 28.0;
-    std::printf("build_ms: rtfact=%.1f embree=%.1f ratio_build_time=%.3f rtfact_points_per_s=%.3g\n", rtBuild, emBuild,
-                rtBuild / emBuild, double(n) / (rtBuild * 1e-3));
+    std::printf("build_ms: rtfact=%.1f embree=%.1f ratio_build_time=%.3f rtfact_points_per_s=%.3g\n", rtTimes.best,
+                emTimes.best, rtTimes.best / emTimes.best, double(n) / (rtTimes.best * 1e-3));
     std::printf(
         "build_first_ms: rtfact=%.1f embree=%.1f ratio_build_time=%.3f rtfact_points_per_s=%.3g (the first of "
         "%d builds, fresh memory)\n",
-        rtFirst, emFirst, rtFirst / emFirst, double(n) / (rtFirst * 1e-3), kBuilds);
+        rtTimes.first, emTimes.first, rtTimes.first / emTimes.first, double(n) / (rtTimes.first * 1e-3), kBuilds);
     // Points per CPU second: the load-independent figure (ideal 2-thread speed = 2x this).
     std::printf(
         "build_cpu_ms: rtfact=%.1f embree=%.1f ratio_build_cpu=%.3f rtfact_points_per_cpu_s=%.3g (embree: with filling "
