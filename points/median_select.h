@@ -135,7 +135,15 @@ inline void selectByCoordinate(Disc* d, size_t n, size_t k, int axis) {
     while (n > kRankSortMax) {
         const size_t samples = std::clamp<size_t>(n / 16, 15, 255) | 1;
         float sample[255];
-        for (size_t s = 0; s < samples; ++s) sample[s] = d[(2 * s + 1) * n / (2 * samples)].center[axis];
+        // Sample s at (2s + 1) n / (2 samples), stepped by quotient and remainder: one
+        // division per round instead of one per sample.
+        const size_t den = 2 * samples, stepQ = 2 * n / den, stepR = 2 * n % den;
+        for (size_t s = 0, q = n / den, r = n % den; s < samples; ++s) {
+            sample[s] = d[q].center[axis];
+            q += stepQ;
+            r += stepR;
+            if (r >= den) r -= den, ++q;
+        }
         std::sort(sample, sample + samples);
         const size_t t = k * samples / n, delta = size_t(std::sqrt(double(samples)));
         const float lo = sample[t > delta ? t - delta : 0], hi = sample[std::min(samples - 1, t + delta)];
