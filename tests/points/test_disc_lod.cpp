@@ -528,6 +528,23 @@ TEST(LoDTree, RankSortMatchesStableSort) {
         }
 }
 
+// The selection's pivot sample sort (by rank up to 128 floats, std::sort beyond) against
+// std::sort at every sample size, with tied and signed-zero values.
+TEST(LoDTree, SampleSortMatchesStdSort) {
+    std::mt19937 rng(47);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    const float special[] = {-0.0f, 0.0f, 2.0f, -2.0f};
+    for (int n = 1; n <= 255; ++n)
+        for (int ties : {0, 4, 1}) {
+            std::vector<float> f(static_cast<size_t>(n));
+            for (float& x : f) x = ties ? special[rng() % uint32_t(ties)] : u(rng);
+            std::vector<float> want = f;
+            std::sort(want.begin(), want.end());
+            sortSample(f.data(), f.size());
+            for (int i = 0; i < n; ++i) ASSERT_EQ(f[size_t(i)], want[size_t(i)]) << n << " " << ties << " at " << i;
+        }
+}
+
 // The selection against std::nth_element: the k-th coordinate at k, nothing greater
 // before it, nothing smaller after it; the same multiset of discs; with distinct,
 // tied (few values) and all-equal coordinates, at every size class.
