@@ -141,9 +141,7 @@ void frameEqualsCli(const std::string& file, engine::SceneKind kind, const std::
 // representatives above them face the other way. Measured 0.45% of pixels off by more than
 // 8/255 (39.4 dB), 0.51% (39.6 dB) since small selections rank-sort (session 38: the scan's
 // tied coordinates split in input order, other clusters); the volume and mesh are exact.
-TEST(ViewerProtocol, PointFrameEqualsCliRender) {
-    frameEqualsCli(kPoints, engine::SceneKind::Points, "points", 0.01);
-}
+TEST(ViewerProtocol, PointFrameEqualsCliRender) { frameEqualsCli(kPoints, engine::SceneKind::Points, "points", 0.01); }
 TEST(ViewerProtocol, VolumeFrameEqualsCliRender) { frameEqualsCli(kVolume, engine::SceneKind::Volume, "volume"); }
 TEST(ViewerProtocol, MeshFrameEqualsCliRender) { frameEqualsCli(kMesh, engine::SceneKind::Mesh, "mesh"); }
 
