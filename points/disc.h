@@ -41,6 +41,17 @@ inline Vec3f unpackRGB(uint32_t c) {
     return Vec3f(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) * (1.0f / 255.0f);
 }
 
+// How far a disc of radius r whose unit normal has component na along an axis reaches
+// along it: r sqrt(1 - na^2), padded by r / 1000 so that the box surely contains the disc
+// whatever the normal's quantisation. Disc::bounds per axis, and the wide LoD BVH's leaf
+// bounds for a block of discs at once (T a SIMD packet).
+template <class T>
+inline T discReach(T r, T na) {
+    using std::max;
+    using std::sqrt;
+    return r * sqrt(max(T(0.0f), T(1.0f) - na * na)) + r * T(1e-3f);
+}
+
 struct Disc {
     Vec3f center;
     float radius = 0;
@@ -49,14 +60,10 @@ struct Disc {
 
     Vec3f n() const { return decodeNormal(normal); }
     uint8_t level() const { return uint8_t(rgba >> 24); }
-    // Tight box of a disc: along axis a it reaches r * sqrt(1 - n_a^2).
+    // Tight box of a disc (discReach along each axis).
     AABB bounds() const { return bounds(center, radius, n()); }
     static AABB bounds(Vec3f center, float radius, Vec3f nn) {
-        const Vec3f e(radius * std::sqrt(std::max(0.0f, 1.0f - nn.x * nn.x)),
-                      radius * std::sqrt(std::max(0.0f, 1.0f - nn.y * nn.y)),
-                      radius * std::sqrt(std::max(0.0f, 1.0f - nn.z * nn.z)));
-        // Quantisation of the normal: widen slightly so the box surely contains the disc.
-        const Vec3f pad = e + Vec3f(radius * 1e-3f);
+        const Vec3f pad(discReach(radius, nn.x), discReach(radius, nn.y), discReach(radius, nn.z));
         return {center - pad, center + pad};
     }
 };

@@ -61,8 +61,7 @@ Sum leafBlock(LoDWideBVH& t, uint32_t first, uint32_t n) {
         k.s.c[a] = laneSum(w * c);
         k.s.n[a] = laneSum(w * nn);
         k.s.col[a] = laneSum(w * toFloat((c8 >> (8 * a)) & PI(255)) * P(1.0f / 255.0f));
-        // Disc::bounds: along axis a a disc reaches r sqrt(1 - n_a^2), padded by r / 1000.
-        const P e = r * sqrt(max(P(0.0f), P(1.0f) - nn * nn)) + r * P(1e-3f);
+        const P e = discReach(r, nn);
         k.s.box.lo[a] = hmin(c - e);
         k.s.box.hi[a] = hmax(c + e);
     }

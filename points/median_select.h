@@ -122,34 +122,29 @@ inline void rankSort(T* d, size_t n, const Key& key) {
     std::copy(tmp, tmp + n, d);
 }
 
-// Sorts n <= L discs by one centre coordinate (ties in input order).
-template <int L>
-inline void rankSortLanes(Disc* d, size_t n, int axis) {
-    rankSort<L>(d, n, [axis](const Disc& x) { return orderedKey(x.center[axis]); });
+// rankSort with as few lanes (16, 32, ... up to Max) as hold n <= Max items.
+template <int Max, int L = 16, class T, class Key>
+inline void rankSortFitting(T* d, size_t n, const Key& key) {
+    if constexpr (L >= Max)
+        rankSort<Max>(d, n, key);
+    else if (n <= size_t(L))
+        rankSort<L>(d, n, key);
+    else
+        rankSortFitting<Max, 2 * L>(d, n, key);
 }
 
 // Ranges up to this size are rank-sorted instead of partitioned further.
 constexpr size_t kRankSortMax = 64;
 
-// rankSortLanes with as few lanes (16, 32 or 64) as hold n <= kRankSortMax discs.
+// Sorts n <= kRankSortMax discs by one centre coordinate (ties in input order).
 inline void rankSortByCoordinate(Disc* d, size_t n, int axis) {
-    if (n <= 16)
-        rankSortLanes<16>(d, n, axis);
-    else if (n <= 32)
-        rankSortLanes<32>(d, n, axis);
-    else
-        rankSortLanes<int(kRankSortMax)>(d, n, axis);
+    rankSortFitting<int(kRankSortMax)>(d, n, [axis](const Disc& x) { return orderedKey(x.center[axis]); });
 }
 
 // Sorts the selection's pivot sample (n <= 255 floats): by rank up to 128.
 inline void sortSample(float* f, size_t n) {
-    auto key = [](float x) { return orderedKey(x); };
-    if (n <= 32)
-        rankSort<32>(f, n, key);
-    else if (n <= 64)
-        rankSort<64>(f, n, key);
-    else if (n <= 128)
-        rankSort<128>(f, n, key);
+    if (n <= 128)
+        rankSortFitting<128>(f, n, [](float x) { return orderedKey(x); });
     else
         std::sort(f, f + n);
 }
