@@ -122,8 +122,10 @@ struct VolumeIntegrator {
         if constexpr (L == VoxelLayout::YZQuads) {
             fetchCube<W>(reinterpret_cast<const uint8_t*>(s.copyVoxels), base, a0, a1, a2, a3, b0, b1, b2, b3);
         } else if constexpr (L == VoxelLayout::YPairs) {
+            // the face at z + 1 from the same indices (an entry is two voxels) and a moved
+            // base: AVX2's per-lane loads take each index out of the vector once for both
             fetchQuad<typename Scene::Voxel, W>(s.copyVoxels, base, a0, a1, b0, b1);
-            fetchQuad<typename Scene::Voxel, W>(s.copyVoxels, base + I(S), a2, a3, b2, b3);
+            fetchQuad<typename Scene::Voxel, W>(s.copyVoxels + 2 * S, base, a2, a3, b2, b3);
         } else {
             fetchPair<typename Scene::Voxel, W>(s.voxels, base, a0, b0);
             fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(R), a1, b1);
