@@ -156,7 +156,7 @@ int benchVolume(int argc, char** argv) {
     float step = 0.5f, fov = 45.0f, refStep = 0.1f;
     int threads = 0, frames = 3, packet = 64;
     std::optional<float> window, level;
-    bool skipPeer = false, skipVtk = false;
+    bool skipPeer = false, skipVtk = false, everyStep = false;
     app.add_option("FILE", file, "Volume file")->required();
     app.add_option("--dims", dims, "Raw dims X,Y,Z");
     app.add_option("--type", type, "Raw type u8|u16|i16|f32");
@@ -184,6 +184,9 @@ int benchVolume(int argc, char** argv) {
         "Write PREFIX_rtfact.png, PREFIX_vtk.png (and _vtk_cast.png), PREFIX_openvdb.png and PREFIX_reference.png");
     app.add_flag("--no-peer", skipPeer, "Only RTfact (no VTK, no OpenVDB)");
     app.add_flag("--no-vtk", skipVtk, "Leave out the VTK peer (it needs an X server: Xvfb without DISPLAY)");
+    app.add_flag("--no-adaptive-steps", everyStep,
+                 "RTfact marches every step in low-opacity bricks too (no 2x/4x steps), as rtfact volume "
+                 "--no-adaptive-steps: its per-sample rate");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -225,6 +228,7 @@ int benchVolume(int argc, char** argv) {
     settings.volume.level = level;
     settings.volume.step = step;
     settings.volume.mode = mode;
+    settings.volume.adaptiveSteps = !everyStep;
     t0 = Clock::now();
     const engine::BuiltVolume built = engine::builtVolume(sc, settings);
     const double buildMs = msSince(t0);
@@ -240,9 +244,9 @@ int benchVolume(int argc, char** argv) {
     std::printf("volume %s: %dx%dx%d %s (%s), %zu of %zu bricks stored, %.1f MB, load %.0f ms, TF %.0f ms\n",
                 file.c_str(), vol.dims[0], vol.dims[1], vol.dims[2], storageName(vol.storage), vol.sourceType.c_str(),
                 vol.storedBricks(), vol.brickCount(), double(vol.memoryBytes()) / 1048576.0, loadMs, buildMs);
-    std::printf("view %dx%d, %s, tf %s window [%g, %g], step %g voxels, packet %d, frames %d (best reported)\n", w, h,
-                mode.c_str(), built.setup.tf.name.c_str(), double(win.first), double(win.second), double(step), packet,
-                frames);
+    std::printf("view %dx%d, %s, tf %s window [%g, %g], step %g voxels%s, packet %d, frames %d (best reported)\n", w, h,
+                mode.c_str(), built.setup.tf.name.c_str(), double(win.first), double(win.second), double(step),
+                everyStep ? " (every step: no adaptive steps)" : "", packet, frames);
     std::printf("cpu: %s, isa %s\n", cpuModel().c_str(), simd::isaName());
     if (!skipPeer && !runVdb)
         std::printf("note: the OpenVDB peer does not shade; left out in --mode %s\n", mode.c_str());

@@ -74,6 +74,15 @@ check "coarse LoD only: missed" has '^missed +16: LoD >= 10x Embree at >= 30 dB,
 "$targets" builds.figures >builds.txt 2>&1
 check "first build judged, best shown" has '^missed +16: LoD build >= 10M points/s, 2T, 32M dragon \(first build; best of two 10.3\) \(M points/s\) 8.1$' builds.txt
 
+# The every-step rate from rtfact-bench volume's table (since session 39: best of frames).
+{
+  echo "== rtfact-bench figures: Test CPU, AVX2 CPU, build ISA native, 2 cores, load 0 0 0, 2026-01-01 00:00 UTC, commit 0000000"
+  echo "-- volume: 512^3 u16 translucent phantom, every step, one thread"
+  echo "   rtfact         1      201.3      5.21       315.4     63484615"
+} >every.figures
+"$targets" every.figures >every.txt 2>&1
+check "every-step rate from the table" has '^met +17: >= 300 Msamples/s per core, 512\^3 phantom, every step \(Msamples/s\) 315$' every.txt
+
 # Bad input: one line naming the file and the problem, exit 1; bad usage exit 2.
 "$targets" "$work/missing.txt" >out.txt 2>err.txt
 check "missing file: exit 1" test $? -eq 1
