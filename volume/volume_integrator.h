@@ -119,18 +119,19 @@ struct VolumeIntegrator {
         const I base = start + cellInBrick<W, R, S>(cell);
         // rows (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1): a = x, b = x + 1
         P a0, b0, a1, b1, a2, b2, a3, b3;
+        // Further rows and faces from the same indices and a moved base: AVX2's per-lane loads
+        // take each index out of the vector once for all of them.
         if constexpr (L == VoxelLayout::YZQuads) {
             fetchCube<W>(reinterpret_cast<const uint8_t*>(s.copyVoxels), base, a0, a1, a2, a3, b0, b1, b2, b3);
         } else if constexpr (L == VoxelLayout::YPairs) {
-            // the face at z + 1 from the same indices (an entry is two voxels) and a moved
-            // base: AVX2's per-lane loads take each index out of the vector once for both
+            // an entry is two voxels
             fetchQuad<typename Scene::Voxel, W>(s.copyVoxels, base, a0, a1, b0, b1);
             fetchQuad<typename Scene::Voxel, W>(s.copyVoxels + 2 * S, base, a2, a3, b2, b3);
         } else {
             fetchPair<typename Scene::Voxel, W>(s.voxels, base, a0, b0);
-            fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(R), a1, b1);
-            fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(S), a2, b2);
-            fetchPair<typename Scene::Voxel, W>(s.voxels, base + I(S + R), a3, b3);
+            fetchPair<typename Scene::Voxel, W>(s.voxels + R, base, a1, b1);
+            fetchPair<typename Scene::Voxel, W>(s.voxels + S, base, a2, b2);
+            fetchPair<typename Scene::Voxel, W>(s.voxels + (S + R), base, a3, b3);
         }
         const P c0 = a0 + (b0 - a0) * fx, c1 = a1 + (b1 - a1) * fx, c2 = a2 + (b2 - a2) * fx, c3 = a3 + (b3 - a3) * fx;
         const P d0 = c0 + (c1 - c0) * fy, d1 = c2 + (c3 - c2) * fy;

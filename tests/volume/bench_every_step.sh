@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # rtfact-bench volume --no-adaptive-steps: RTfact marches every step (issue 17's per-sample
 # rate), so on the shipped tooth CT with the translucent ramp it takes more samples than the
-# default adaptive march (74,523 against 96,866 at 64x64, step 0.5), and says so in its view
+# default adaptive march (96,866 against 74,523 at 64x64, step 0.5), and says so in its view
 # line; the default run does not.
 # usage: bench_every_step.sh RTFACT_BENCH DATASETS_DIR
 set -uo pipefail
