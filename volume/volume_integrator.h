@@ -40,8 +40,8 @@ struct VolumeIntegrator {
         // chains (brick, voxels, TF) are independent, so each hides the others' latency. Eight
         // AVX2 chunks spill too much. Pairs where more lanes cost more than they hide (measured):
         // isosurfaces (a crossing in any lane bisects all), and on AVX2 MIP (a short step: the
-        // spills weigh more) and brick pools the row layout prefetches (fewer lanes wait for
-        // the longest ray of the group; measured so, the march's copy keeps four).
+        // spills weigh more). (Brick pools the row layout prefetches marched in pairs on AVX2
+        // until the prefetch was spread over four steps: session 40.)
         constexpr int W = Packet<N>::W, C = Packet<N>::C, G = C % 4 == 0 ? 4 : C % 2 == 0 ? 2 : 1;
         constexpr int G2 = G == 4 ? 2 : G;
         // The mode is fixed at compile time: the other modes' state and branches drop out of
@@ -63,11 +63,6 @@ struct VolumeIntegrator {
         auto marchMode = [&]<VolumeMode M>() {
             if constexpr (M == VolumeMode::Iso || (W == 8 && M == VolumeMode::MIP)) {
                 marchGroups.template operator()<G2, M>();
-            } else if constexpr (W == 8) {
-                if (L == VoxelLayout::Rows && s.prefetchBricks)
-                    marchGroups.template operator()<G2, M>();
-                else
-                    marchGroups.template operator()<G, M>();
             } else {
                 marchGroups.template operator()<G, M>();
             }
