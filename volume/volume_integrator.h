@@ -11,6 +11,7 @@
 #include "core/concepts/integrator.h"
 #include "core/render/render_counters.h"
 #include "core/simd/chunk_group.h"
+#include "core/util/prefetch.h"
 #include "volume/volume_scene.h"
 #include "volume/voxel_gather.h"
 
@@ -40,8 +41,7 @@ struct VolumeIntegrator {
         // chains (brick, voxels, TF) are independent, so each hides the others' latency. Eight
         // AVX2 chunks spill too much. Pairs where more lanes cost more than they hide (measured):
         // isosurfaces (a crossing in any lane bisects all), and on AVX2 MIP (a short step: the
-        // spills weigh more). (Brick pools the row layout prefetches marched in pairs on AVX2
-        // until the prefetch was spread over four steps: session 40.)
+        // spills weigh more).
         constexpr int W = Packet<N>::W, C = Packet<N>::C, G = C % 4 == 0 ? 4 : C % 2 == 0 ? 2 : 1;
         constexpr int G2 = G == 4 ? 2 : G;
         // The mode is fixed at compile time: the other modes' state and branches drop out of
@@ -297,14 +297,13 @@ struct VolumeIntegrator {
         // prefetch the brick one brick edge ahead along their ray and its sub-brick entries,
         // once per brick (the last two bricks prefetched are remembered: the two lanes mostly
         // share one). In cache the prefetches cost more than they save.
-        // The brick's lines are issued a quarter a step (all of them in the four steps before
-        // the next look ahead), from [pfNext, pfEnd) of the last two bricks: issued at once
-        // they filled the miss buffers, and the march's own loads waited behind them.
+        // The brick's lines are issued a quarter a step (PrefetchRange: all of them in the four
+        // steps before the next look ahead), for the last two bricks.
         int32_t recent[2] = {-1, -1};
         const float aheadT = float(Scene::kCells) * s.dt / s.settings.stepVoxels;
         constexpr size_t kBrickBytes = Scene::template kEntryBytes<L> * size_t(Scene::template kBrickStride<L>);
-        constexpr int kPfLines = int((kBrickBytes + 63) / 64 + 4) / 4;  // + 1: a brick need not start on a line
-        uintptr_t pfNext[2] = {0, 0}, pfEnd[2] = {0, 0};
+        constexpr int kLinesPerStep = int(PrefetchRange::maxLines(kBrickBytes) + 3) / 4;
+        PrefetchRange brickLines[2];
         int pfSlot = 0;
         auto prefetchAhead = [&](int i) __attribute__((always_inline)) {
             const float ta = t[i] + aheadT;
@@ -324,27 +323,24 @@ struct VolumeIntegrator {
             __builtin_prefetch(si + sx);
             __builtin_prefetch(si + sxy);
             __builtin_prefetch(si + sx + sxy);
-            const uintptr_t first = uintptr_t(s.template entryBase<L>() +
-                                              size_t(s.template entryStart<L>()[id]) * Scene::template kEntryBytes<L>);
-            pfNext[pfSlot] = first & ~uintptr_t(63);
-            pfEnd[pfSlot] = first + kBrickBytes;
+            brickLines[pfSlot].reset(
+                s.template entryBase<L>() + size_t(s.template entryStart<L>()[id]) * Scene::template kEntryBytes<L>,
+                kBrickBytes);
             pfSlot ^= 1;
-        };
-        auto prefetchSome = [&]() __attribute__((always_inline)) {
-            for (int k = 0; k < 2; ++k)
-                for (int j = 0; j < kPfLines && pfNext[k] < pfEnd[k]; ++j, pfNext[k] += 64)
-                    __builtin_prefetch(reinterpret_cast<const void*>(pfNext[k]));
         };
         uint32_t iteration = 0;
         while (any(alive)) {
             // every fourth step: the brick ahead is at least kCells / stepVoxels steps away
-            if (s.prefetchBricks && (iteration++ & 3) == 0) {
-                static_assert(W <= 64);
-                const uint64_t lanes = BitMask<W>(alive).w[0];
-                prefetchAhead(__builtin_ctzll(lanes));
-                prefetchAhead(63 - __builtin_clzll(lanes));
+            if (s.prefetchBricks) {
+                if ((iteration++ & 3) == 0) {
+                    static_assert(W <= 64);
+                    const uint64_t lanes = BitMask<W>(alive).w[0];
+                    prefetchAhead(__builtin_ctzll(lanes));
+                    prefetchAhead(63 - __builtin_clzll(lanes));
+                }
+                brickLines[0].issue(kLinesPerStep);
+                brickLines[1].issue(kLinesPerStep);
             }
-            if (s.prefetchBricks) prefetchSome();
             const Vec3<W> p = clampToGrid<W>(s, oi + di * t);
             // the sample's cell, its brick and sub-brick (p >= 0: floor(p / 8) = floor(p) / 8;
             // p < dims - 1 keeps them inside their grids)
