@@ -298,7 +298,8 @@ struct VolumeIntegrator {
         // once per brick (the last two bricks prefetched are remembered: the two lanes mostly
         // share one). In cache the prefetches cost more than they save.
         // The brick's lines are issued a quarter a step (PrefetchRange: all of them in the four
-        // steps before the next look ahead), for the last two bricks.
+        // steps before the next look ahead), for the last two bricks, at the end of the step:
+        // behind the step's own loads, which then do not queue behind them.
         int32_t recent[2] = {-1, -1};
         const float aheadT = float(Scene::kCells) * s.dt / s.settings.stepVoxels;
         constexpr size_t kBrickBytes = Scene::template kEntryBytes<L> * size_t(Scene::template kBrickStride<L>);
@@ -331,15 +332,11 @@ struct VolumeIntegrator {
         uint32_t iteration = 0;
         while (any(alive)) {
             // every fourth step: the brick ahead is at least kCells / stepVoxels steps away
-            if (s.prefetchBricks) {
-                if ((iteration++ & 3) == 0) {
-                    static_assert(W <= 64);
-                    const uint64_t lanes = BitMask<W>(alive).w[0];
-                    prefetchAhead(__builtin_ctzll(lanes));
-                    prefetchAhead(63 - __builtin_clzll(lanes));
-                }
-                brickLines[0].issue(kLinesPerStep);
-                brickLines[1].issue(kLinesPerStep);
+            if (s.prefetchBricks && (iteration++ & 3) == 0) {
+                static_assert(W <= 64);
+                const uint64_t lanes = BitMask<W>(alive).w[0];
+                prefetchAhead(__builtin_ctzll(lanes));
+                prefetchAhead(63 - __builtin_clzll(lanes));
             }
             const Vec3<W> p = clampToGrid<W>(s, oi + di * t);
             // the sample's cell, its brick and sub-brick (p >= 0: floor(p / 8) = floor(p) / 8;
@@ -471,6 +468,10 @@ struct VolumeIntegrator {
                 t = select(samp, tNear + (kf + P(0.5f)) * dt, t);
             }
             alive = alive & (t < tFar);
+            if (s.prefetchBricks) {
+                brickLines[0].issue(kLinesPerStep);
+                brickLines[1].issue(kLinesPerStep);
+            }
         }
         if constexpr (mode == VolumeMode::MIP) {
             const Mask<W> hit = maxv > P(-kInfinity);
