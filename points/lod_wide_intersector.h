@@ -195,13 +195,11 @@ struct LoDWideIntersector {
                         stack[sp++] = Entry{n.child[c], n.count[c], 0.0f};
                     }
                 } else {
-                    const int base = sp;
-                    for (; bits; bits &= bits - 1) {
-                        const int c = __builtin_ctzll(bits);
-                        const Entry e{n.child[c], n.count[c], tn[c]};
-                        prefetchEntry(bvh, e.child, e.count);
-                        pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
-                    }
+                    // far to near: the nearest ends on top
+                    pushRanked(stack, sp, bits, tn, [&](int c) {
+                        prefetchEntry(bvh, n.child[c], n.count[c]);
+                        return Entry{n.child[c], n.count[c], tn[c]};
+                    });
                 }
             }
             for (;;) {

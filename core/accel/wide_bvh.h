@@ -261,6 +261,24 @@ inline void pushSorted(Entry* stack, int& sp, int base, const Entry& e) {
     stack[j] = e;
 }
 
+// The same order for the children `bits` of one node at once, with distances `dist`:
+// each entry (make(c) for child slot c) is stored at its rank, the number of entries
+// popped before it (nearer ones, and equally near ones of later slots, as pushSorted
+// in slot order leaves them). One K-wide compare per child and no data-dependent
+// branch: the insertion's comparisons mispredict on incoherent rays (diffuse bounces
+// through the 8-wide BVH: ~5% of their time, AVX2 build, session 42).
+template <class Entry, int K, class Make>
+RTFACT_INLINE void pushRanked(Entry* stack, int& sp, uint64_t bits, const Packet<K>& dist, Make&& make) {
+    const int top = sp + __builtin_popcountll(bits) - 1;
+    for (uint64_t r = bits; r; r &= r - 1) {
+        const int c = __builtin_ctzll(r);
+        const Packet<K> d(dist[c]);
+        const uint64_t before = (BitMask<K>(dist < d).w[0] | (BitMask<K>(dist == d).w[0] & (~uint64_t(1) << c))) & bits;
+        stack[top - __builtin_popcountll(before)] = make(c);
+    }
+    sp = top + 1;
+}
+
 // Any hit among n leaf blocks (the blocks' occludedBlocks): the first hit lane of the
 // first block with one wins and goes into hit (t, id). test(block, t) returns the mask of
 // the block's lanes hit in (tMin, hit.t) and sets their distances t.

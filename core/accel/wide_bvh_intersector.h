@@ -238,19 +238,20 @@ struct WideBVHIntersector {
                     next = Entry{n.child[c0], n.count[c0], tn[c0]};
                 } else if (!(rest & (rest - 1))) {
                     // Two children (the common case): the far one is pushed, the near one next.
+                    // Chosen by index, not by a branch (which the distances make unpredictable).
                     const int c1 = __builtin_ctzll(rest);
-                    Entry farE{n.child[c1], n.count[c1], tn[c1]};
-                    next = Entry{n.child[c0], n.count[c0], tn[c0]};
-                    if (farE.dist <= next.dist) std::swap(next, farE);  // ties: the later slot first, as sorted
-                    push(bvh, farE);
+                    const float d0 = tn[c0], d1 = tn[c1];
+                    const bool swap = d1 <= d0;  // ties: the later slot first, as sorted
+                    const int cn = swap ? c1 : c0, cf = swap ? c0 : c1;
+                    next = Entry{n.child[cn], n.count[cn], swap ? d1 : d0};
+                    push(bvh, Entry{n.child[cf], n.count[cf], swap ? d0 : d1});
                 } else {
-                    const int base = sp;
-                    for (; bits; bits &= bits - 1) {
-                        const int c = __builtin_ctzll(bits);
+                    // Three or more: placed by rank (pushRanked), no insertion branches.
+                    pushRanked(stack, sp, bits, tn, [&](int c) {
                         const Entry e{n.child[c], n.count[c], tn[c]};
                         prefetchEntry(bvh, e);
-                        pushSorted(stack, sp, base, e);  // far to near: the nearest ends on top
-                    }
+                        return e;
+                    });
                 }
                 haveNext = AnyHit || !(rest & (rest - 1));
             }

@@ -9,6 +9,7 @@
 #include "core/accel/median_bvh_builder.h"
 #include "core/accel/sah_bvh_builder.h"
 #include "core/accel/sah_kdtree_builder.h"
+#include "core/accel/wide_bvh.h"
 #include "core/geometry/sphere.h"
 
 using namespace rtfact;
@@ -138,4 +139,42 @@ TEST(Traversal, IdenticalElements) {
     const auto tree = buildKdTree<Sphere>(SAHKdTreeBuilder{}, s);
     checkAgainstBruteForce<16>(bvh, BVHIntersector<SphereIntersector>{}, s);
     checkAgainstBruteForce<16>(tree, KdTreeIntersector<SphereIntersector>{}, s);
+}
+
+// pushRanked (a node's children placed on the stack by rank) leaves the stack exactly as
+// pushSorted in slot order does, ties included, on top of entries already there; any
+// subset of K slots, distances drawn from a few values so that ties are common.
+template <int K>
+void checkPushRankedMatchesPushSorted() {
+    struct Entry {
+        int32_t child;
+        float dist;
+    };
+    std::mt19937 rng(42 + K);
+    std::uniform_int_distribution<int> value(0, 3), below(0, 5);
+    for (int round = 0; round < 2000; ++round) {
+        Packet<K> dist;
+        for (int c = 0; c < K; ++c) dist[c] = float(value(rng)) * 0.5f;
+        const uint64_t bits = uint64_t(rng()) & ((uint64_t(1) << K) - 1);
+        Entry sorted[K + 6], ranked[K + 6];
+        const int base = below(rng);
+        for (int i = 0; i < base; ++i) sorted[i] = ranked[i] = Entry{-1 - i, 9.0f};
+        int sp = base, rp = base;
+        for (uint64_t b = bits; b; b &= b - 1) {
+            const int c = __builtin_ctzll(b);
+            pushSorted(sorted, sp, base, Entry{c, dist[c]});
+        }
+        pushRanked(ranked, rp, bits, dist, [&](int c) { return Entry{c, dist[c]}; });
+        ASSERT_EQ(rp, sp) << "K " << K << " round " << round;
+        for (int i = 0; i < sp; ++i) {
+            ASSERT_EQ(ranked[i].child, sorted[i].child) << "K " << K << " round " << round << " slot " << i;
+            ASSERT_EQ(ranked[i].dist, sorted[i].dist);
+        }
+    }
+}
+
+TEST(Traversal, PushRankedMatchesPushSorted) {
+    checkPushRankedMatchesPushSorted<4>();
+    checkPushRankedMatchesPushSorted<8>();
+    checkPushRankedMatchesPushSorted<16>();
 }
