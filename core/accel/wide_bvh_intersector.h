@@ -141,7 +141,7 @@ struct WideBVHIntersector {
     // test, its pushes, then pops and leaves up to the next inner node), so independent
     // rays can be interleaved (traverseLanesFrom) and one ray's node load overlaps the work of
     // the others. Closest hit: children hit are visited near to far (three or more are
-    // insertion-sorted onto the stack) and a popped entry is skipped once a closer hit is
+    // placed on the stack by rank, pushRanked) and a popped entry is skipped once a closer hit is
     // known. Any hit: no ordering at all, larger children first (the builder's slot order).
     // The child visited next (a single one, the nearer of two, any hit's first) is entered
     // or its leaf tested at once, not pushed and popped. Every inner child entered or pushed
