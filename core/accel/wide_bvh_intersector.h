@@ -234,17 +234,20 @@ struct WideBVHIntersector {
                         r &= ~(uint64_t(1) << c);
                         push(bvh, Entry{n.child[c], n.count[c], 0.0f});
                     }
-                } else if (!rest) {
-                    next = Entry{n.child[c0], n.count[c0], tn[c0]};
                 } else if (!(rest & (rest - 1))) {
-                    // Two children (the common case): the far one is pushed, the near one next.
-                    // Chosen by index, not by a branch (which the distances make unpredictable).
-                    const int c1 = __builtin_ctzll(rest);
+                    // One or two children (the common cases, told apart without a branch): the
+                    // far one is pushed (with one child, a copy of it is stored and not counted),
+                    // the near one next, chosen by a select (the distances make a branch
+                    // unpredictable).
+                    const int c1 = rest ? __builtin_ctzll(rest) : c0;
                     const float d0 = tn[c0], d1 = tn[c1];
                     const bool swap = d1 <= d0;  // ties: the later slot first, as sorted
                     const int cn = swap ? c1 : c0, cf = swap ? c0 : c1;
                     next = Entry{n.child[cn], n.count[cn], swap ? d1 : d0};
-                    push(bvh, Entry{n.child[cf], n.count[cf], swap ? d0 : d1});
+                    const Entry farE{n.child[cf], n.count[cf], swap ? d0 : d1};
+                    prefetchEntry(bvh, farE);
+                    stack[sp] = farE;
+                    sp += rest != 0;
                 } else {
                     // Three or more: placed by rank (pushRanked), no insertion branches.
                     pushRanked(stack, sp, bits, tn, [&](int c) {
