@@ -73,7 +73,7 @@ struct RTfactSide {
                         f.hit[pix] = 0;
                         continue;
                     }
-                    const Disc& d = scene.disc(id);
+                    const Disc d = scene.disc(id);
                     f.shade[pix] = std::fabs(dot(d.n(), rays.dir.lane(i))) * luminance(d.rgba);
                     f.hit[pix] = 1;
                 }

@@ -77,6 +77,27 @@ Sum leafBlock(LoDWideBVH& t, uint32_t first, uint32_t n) {
     return k;
 }
 
+// Child c of node ni's representative (null: an empty slot, +inf radius, never cut): its
+// centre, radius and decoded normal in the node's child summaries, its octahedral normal
+// and colour in reps.
+void setRep(LoDWideBVH& t, size_t ni, int c, const Disc* rep) {
+    LoDChildReps<K>& cr = t.childReps[ni];
+    LoDRepLook& look = t.reps[ni * K + size_t(c)];
+    if (!rep) {
+        cr.radius[c] = std::numeric_limits<float>::infinity();
+        for (int a = 0; a < 3; ++a) cr.c[a][c] = cr.n[a][c] = 0.0f;
+        look = LoDRepLook{};
+        return;
+    }
+    const Vec3f nn = rep->n();
+    cr.radius[c] = rep->radius;
+    for (int a = 0; a < 3; ++a) {
+        cr.c[a][c] = rep->center[a];
+        cr.n[a][c] = nn[a];
+    }
+    look = LoDRepLook{rep->normal, rep->rgba};
+}
+
 // How a range of `count` discs is cut into the (at most K) children of a wide node. The
 // children are complete subtrees of `cap` = S K^j discs (the largest such below count),
 // the last one holding the rest: a part of more than cap discs is halved at a multiple of
@@ -188,26 +209,16 @@ Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, int depth) 
     else
         for (int i = 0; i < p.parts; ++i) child(i);
     WideBVHNode<K>& node = t.nodes[ni];
-    LoDChildReps<K>& cr = t.childReps[ni];
     Sum out;
     for (int c = 0; c < K; ++c) {
-        Disc& rep = t.reps[size_t(ni) * K + size_t(c)];
         if (c >= p.parts) {
             node.clear(c);
-            cr.radius[c] = std::numeric_limits<float>::infinity();
-            for (int a = 0; a < 3; ++a) cr.c[a][c] = cr.n[a][c] = 0.0f;
-            rep = Disc{};
+            setRep(t, size_t(ni), c, nullptr);
             continue;
         }
         const bool leaf = p.count[c] <= uint32_t(S);
         node.set(c, kids[c].s.box, int32_t(leaf ? (first + p.first[c]) / S : slot[c]), leaf ? int32_t(p.count[c]) : 0);
-        rep = kids[c].rep;
-        const Vec3f nn = rep.n();
-        cr.radius[c] = rep.radius;
-        for (int a = 0; a < 3; ++a) {
-            cr.c[a][c] = rep.center[a];
-            cr.n[a][c] = nn[a];
-        }
+        setRep(t, size_t(ni), c, &kids[c].rep);
         out.s.add(kids[c].s);
     }
     out.s.height += 1;
@@ -247,22 +258,12 @@ Sum summarise(LoDWideBVH& t, int32_t ni, int depth) {
     else
         for (int c = 0; c < K; ++c) child(c);
     Sum out;
-    LoDChildReps<K>& cr = t.childReps[size_t(ni)];
     for (int c = 0; c < K; ++c) {
-        Disc* rep = &t.reps[size_t(ni) * K + size_t(c)];
         if (node.isEmpty(c)) {
-            cr.radius[c] = std::numeric_limits<float>::infinity();
-            for (int a = 0; a < 3; ++a) cr.c[a][c] = cr.n[a][c] = 0.0f;
-            *rep = Disc{};
+            setRep(t, size_t(ni), c, nullptr);
             continue;
         }
-        *rep = kids[c].rep;
-        const Vec3f nn = rep->n();
-        cr.radius[c] = rep->radius;
-        for (int a = 0; a < 3; ++a) {
-            cr.c[a][c] = rep->center[a];
-            cr.n[a][c] = nn[a];
-        }
+        setRep(t, size_t(ni), c, &kids[c].rep);
         out.s.add(kids[c].s);
     }
     out.s.height += 1;

@@ -67,7 +67,9 @@ struct PointScene {
     double bytesPerPoint() const { return discs().empty() ? 0.0 : double(memoryBytes()) / double(discs().size()); }
     size_t nodeCount() const { return isWide() ? wide.nodes.size() : tree.nodes.size(); }
     AABB bounds() const { return isWide() ? wide.box : tree.box; }
-    const Disc& disc(int32_t id) const {
+    // The disc a hit id names (a representative's for ids <= -2), by value: the wide tree
+    // assembles its representatives from two arrays.
+    Disc disc(int32_t id) const {
         if (isWide()) return wide.disc(id);
         return id >= 0 ? tree.elems[size_t(id)] : tree.inner[size_t(-id - 2)].rep;
     }
@@ -91,7 +93,7 @@ struct PointScene {
         for (int i = 0; i < N; ++i) {
             if (!valid[i]) continue;
             const int32_t id = hit.id[i];
-            const Disc& d = disc(id);
+            const Disc d = disc(id);
             reps += id < 0;
             Vec3f nn = d.n();
             Vec3f c;

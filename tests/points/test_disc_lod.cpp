@@ -764,7 +764,7 @@ RepHitStats checkWideRepresentativeHits(const PointScene& scene, bool commonOrig
             if (coarse.id[i] > -2) continue;
             ++st.repHits;
             const uint32_t slot = uint32_t(-coarse.id[i] - 2);
-            const Disc& rep = w.reps[slot];
+            const Disc rep = w.rep(slot);
             const float R = rep.radius;
             const Vec3f p = rays.org.lane(i) + rays.dir.lane(i) * coarse.t[i];
             EXPECT_NEAR(dot(p - rep.center, rep.n()), 0.0f, 1e-4f * std::max(1.0f, R)) << "off the disc plane";
@@ -849,14 +849,14 @@ TEST_P(DiscWideBVHSplit, ChildRepresentativesCoverTheirSubtrees) {
         const Disc& d = w.elems[i];
         for (uint32_t slot : slots[i]) {
             // The farthest point of the disc from the representative's centre.
-            const Disc& rep = w.reps[slot];
+            const Disc rep = w.rep(slot);
             const Vec3f off = d.center - rep.center, nn = d.n();
             const float along = dot(off, nn), across = length(off - nn * along);
             EXPECT_LE(std::sqrt(along * along + (across + d.radius) * (across + d.radius)), rep.radius * (1.0f + 1e-5f))
                 << "slot " << slot;
             ++covered[slot];
         }
-        EXPECT_EQ(w.reps[slots[i].back()].level(), 1);  // a leaf child
+        EXPECT_EQ(w.rep(slots[i].back()).level(), 1);  // a leaf child
     }
     for (size_t ni = 0; ni < w.nodes.size(); ++ni)
         for (int c = 0; c < K; ++c) {
@@ -868,13 +868,12 @@ TEST_P(DiscWideBVHSplit, ChildRepresentativesCoverTheirSubtrees) {
                 continue;
             }
             EXPECT_GT(covered[slot], 0);
-            const Disc& rep = w.reps[slot];
-            EXPECT_EQ(cr.radius[c], rep.radius);
+            // Centre and radius come from the summaries; the normal the traversal tests is
+            // the one the shading decodes from the representative's octahedral form.
+            const Disc rep = w.rep(slot);
+            EXPECT_TRUE(std::isfinite(rep.radius) && rep.radius > 0.0f);
             const Vec3f nn = rep.n();
-            for (int a = 0; a < 3; ++a) {
-                EXPECT_EQ(cr.c[a][c], rep.center[a]);
-                EXPECT_EQ(cr.n[a][c], nn[a]);
-            }
+            for (int a = 0; a < 3; ++a) EXPECT_EQ(cr.n[a][c], nn[a]);
             if (!w.nodes[ni].isLeaf(c)) {
                 EXPECT_GE(rep.level(), 2);
             }
