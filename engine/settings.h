@@ -33,7 +33,7 @@ struct PointSettings {
     float radiusFactor = 1.0f;     // times the spacing estimate or the file's radii
     int leafSize = 8;
     // kd: the LoD kd-tree (~31 bytes per point); wide: the wide BVH of 8-disc blocks with
-    // child summaries in the parents, median split (~100 bytes per point, traces packets
+    // child summaries in the parents, median split (~65 bytes per point, traces packets
     // faster, docs/benchmarks.md). Full-detail images are the same with both.
     std::string accel = "kd";
     int aoSamples = 8;

@@ -137,7 +137,7 @@ void PointOptions::addTo(CLI::App& cmd) {
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
     cmd.add_option("--accel", ps.accel,
-                   "Structure: kd (LoD kd-tree, ~31 bytes per point) | wide (wide BVH, ~100 bytes per point, "
+                   "Structure: kd (LoD kd-tree, ~31 bytes per point) | wide (wide BVH, ~65 bytes per point, "
                    "faster to trace)")
         ->capture_default_str()
         ->check(CLI::IsMember(engine::pointAccels()));
