@@ -183,13 +183,14 @@ void splitRange(const Plan& p, Disc* d, uint32_t f, uint32_t c) {
 // spread as planned, children built (the large ones in parallel), their boxes and
 // representatives stored in the node; returns the node's sum. Subtrees take the slots
 // after their parent, depth first.
-Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, int depth) {
+Sum buildNode(Ctx& ctx, uint32_t ni, uint32_t first, uint32_t count, int depth, bool split = true) {
     LoDWideBVH& t = *ctx.t;
     RTFACT_ASSERT(depth < LoDWideBVH::kMaxDepth, "wide LoD tree deeper than its traversal stack");
     const Plan p = makePlan(count);
     // Replay the plan on the discs: each step selects the median of one range; the
-    // halves of a step are independent, so large ones are split in parallel.
-    splitRange(p, t.elems.data() + first, 0, count);
+    // halves of a step are independent, so large ones are split in parallel. (split
+    // false: done by the caller.)
+    if (split) splitRange(p, t.elems.data() + first, 0, count);
     // Slots: children's subtrees follow this node in part order.
     uint32_t slot[K];
     uint32_t next = ni + 1;
@@ -310,12 +311,20 @@ LoDWideBVH buildLoDWideBVH(std::vector<Disc> discs, LoDWideSplit split) {
     t.elems = std::move(discs);
     NodeCounts counts;
     const uint32_t nodes = counts(n);
-    resizeFreshHugePages(t.nodes, nodes);
-    resizeFreshHugePages(t.childReps, nodes);
-    resizeFreshHugePages(t.reps, size_t(nodes) * K);
-    resizeHugePages(t.blocks, (n + S - 1) / S);
+    resizeHugePages(t.blocks, (n + S - 1) / S);  // left uninitialised: leafBlock fills them
+    // The nodes, child summaries and representatives are value-initialised (fresh memory: on
+    // VMs whose host reclaims freed pages, ~0.2 s a thread per 100 MB for the first touch)
+    // while the root's median splits, which read and write only the discs, run beside it:
+    // the other thread no longer waits for the first touch.
+    tbb::parallel_invoke(
+        [&] {
+            resizeFreshHugePages(t.nodes, nodes);
+            resizeFreshHugePages(t.childReps, nodes);
+            resizeFreshHugePages(t.reps, size_t(nodes) * K);
+        },
+        [&] { splitRange(makePlan(n), t.elems.data(), 0, n); });
     Ctx ctx{&t, &counts};
-    const Sum root = buildNode(ctx, 0, 0, n, 0);
+    const Sum root = buildNode(ctx, 0, 0, n, 0, false);
     t.box = root.s.box;
     return t;
 }
