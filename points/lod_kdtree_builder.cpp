@@ -53,7 +53,9 @@ void quantiseChildBox(LoDInner& in, int child, const AABB& b) {
     }
 }
 
-Agg buildNode(Ctx& ctx, Disc* d, size_t n, uint32_t slot, uint32_t next) {
+// selectedAxis >= 0: d is already split at its median along that axis (the root, split
+// while the node arrays are first touched).
+Agg buildNode(Ctx& ctx, Disc* d, size_t n, uint32_t slot, uint32_t next, int selectedAxis = -1) {
     LoDKdTree& t = *ctx.tree;
     Agg a;
     if (n <= ctx.leafSize) {
@@ -67,9 +69,9 @@ Agg buildNode(Ctx& ctx, Disc* d, size_t n, uint32_t slot, uint32_t next) {
         a.rep = rep;
         return a;
     }
-    const int axis = spreadAxis(d, n);
+    const int axis = selectedAxis >= 0 ? selectedAxis : spreadAxis(d, n);
     const size_t half = n / 2;
-    selectMedianByCoordinate(d, n, half, axis);
+    if (selectedAxis < 0) selectMedianByCoordinate(d, n, half, axis);
     const float split = d[half].center[axis];
     const uint32_t left = next;
     t.nodes[slot] = KdNode::inner(axis, split, left);
@@ -109,9 +111,20 @@ LoDKdTree LoDKdTreeBuilder::build(std::vector<Disc> discs) const {
     if (discs.size() >= (size_t(1) << 29)) throw Error("", "too many points for one tree (limit 2^29)");
     Ctx ctx{&t, discs.data(), size_t(std::max(1, maxLeafSize)), {}};
     const uint32_t total = 1 + ctx.computeDesc(discs.size());
-    resizeFreshHugePages(t.nodes, total);
-    resizeFreshHugePages(t.inner, (total - 1) / 2);
-    const Agg a = buildNode(ctx, discs.data(), discs.size(), 0, 1);
+    // The node arrays are value-initialised (fresh memory, slow to touch first on VMs whose
+    // host reclaims freed pages) while the root's median selection, which touches only the
+    // discs, runs beside it.
+    const size_t n = discs.size();
+    const int rootAxis = n > ctx.leafSize ? spreadAxis(discs.data(), n) : -1;
+    tbb::parallel_invoke(
+        [&] {
+            resizeFreshHugePages(t.nodes, total);
+            resizeFreshHugePages(t.inner, (total - 1) / 2);
+        },
+        [&] {
+            if (rootAxis >= 0) selectMedianByCoordinate(discs.data(), n, n / 2, rootAxis);
+        });
+    const Agg a = buildNode(ctx, discs.data(), n, 0, 1, rootAxis);
     t.box = a.s.box;
     const Vec3f pad = Vec3f(1e-6f * (maxComponent(vmax(-a.s.box.lo, a.s.box.hi)) + maxComponent(a.s.box.extent())));
     t.box.lo -= pad;
