@@ -101,6 +101,12 @@ void RenderSession::setScale(int scale) {
 
 void RenderSession::cancel() { cancel_.store(true); }
 
+void RenderSession::restart() {
+    std::lock_guard l(state_);
+    ++generation_;
+    cancel_.store(true);
+}
+
 void RenderSession::onFrame(std::function<void(const Frame&)> f) {
     std::lock_guard l(state_);
     frameCb_ = std::move(f);

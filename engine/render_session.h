@@ -76,6 +76,9 @@ class RenderSession {
     void setScale(int scale);
     // Stops the pass in flight within one tile per render thread (it returns Cancelled).
     void cancel();
+    // Starts the accumulation over with the same view (and cancels the pass in flight):
+    // the next pass is sample 1 again.
+    void restart();
     // Called after every completed pass with the accumulated image (on the rendering thread).
     void onFrame(std::function<void(const Frame&)> f);
     // Called after every tile with (tiles done, tiles in the pass) (on worker threads).

@@ -268,7 +268,15 @@ void ClientSession::renderOnce(std::unique_lock<std::mutex>& lock) {
         out_.text(errorJson(error).dump());
         return;
     }
-    if (r.status != engine::PassResult::Status::Done || generation != generation_) return;  // stale
+    if (r.status != engine::PassResult::Status::Done) return;
+    if (generation != generation_) {
+        // Stale. A camera change that reached the engine before the pass took its snapshot
+        // made this pass the new view's first sample, which the next pass would then add to
+        // (one sample past maxSamples, and the frame of sample 1 never sent): start that
+        // view's samples over.
+        if (session == session_) session->restart();
+        return;
+    }
     goodSettings_ = settings_;
     goodPatch_ = patch_;
     accumulated_ = r.samples;

@@ -122,6 +122,20 @@ TEST(RenderSession, SettingsChangeRestarts) {
     EXPECT_EQ(session.frame().rgba, oneShot(bunny(), eye, size(32, 32), cam, 1).rgba);
 }
 
+// restart() keeps the view and starts its samples over: the next pass is sample 1 and its
+// image that of a one-sample render.
+TEST(RenderSession, RestartStartsTheSamplesOver) {
+    const CameraFrame cam = cameraOf(bunny(), {0.6f, 0.45f, 1.0f});
+    RenderSession session(bunny(), ao(), size(32, 32), cam);
+    session.renderPass();
+    EXPECT_EQ(session.renderPass().samples, 2);
+    session.restart();
+    EXPECT_EQ(session.samples(), 2);  // the accumulated image stays until the next pass
+    EXPECT_EQ(session.renderPass().samples, 1);
+    EXPECT_EQ(session.frame().rgba, oneShot(bunny(), ao(), size(32, 32), cam, 1).rgba);
+    EXPECT_EQ(session.renderPass().samples, 2);
+}
+
 // Thread B changes the camera while thread A is inside a pass (A's worker is held in
 // the tile callback until B has made the change): that pass is abandoned, no tile
 // starts after the change, and the next frame shows the new camera.
