@@ -231,6 +231,7 @@ void ClientSession::renderOnce(std::unique_lock<std::mutex>& lock) {
     const bool mv = moving_;
     const ViewerConfig::PassRequest request{view_, camera_, settings_, patch_, width_, height_, scale_};
     lock.unlock();
+    if (config_.beforePass) config_.beforePass();
     engine::PassResult r;
     engine::Frame frame;
     std::string error;

@@ -49,6 +49,9 @@ struct ViewerConfig {
     };
     std::function<std::pair<engine::PassResult, engine::Frame>(const PassRequest&)> renderPass;
     std::function<void(uint64_t view)> closeView;  // the tab is gone
+    // Tests: called on the render thread after a pass's request is taken and before the
+    // pass starts (the window where a message can overtake the pass).
+    std::function<void()> beforePass;
 };
 
 class ClientSession {

@@ -2,6 +2,7 @@
 // frame waiting is replaced by a newer one (the page never receives a stale picture).
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <mutex>
 #include <thread>
@@ -89,6 +90,49 @@ TEST(ClientSession, FramesWaitForTheAckAndOnlyTheNewestWaits) {
     ASSERT_EQ(cap.count(), 3u);
     EXPECT_EQ(cap.frame(2)["camera"]["fov"], 30.0);
     EXPECT_EQ(cap.frame(2)["samples"], 5);
+}
+
+// A camera message that arrives after the tab took a pass's request but before the engine
+// took its snapshot makes that pass the new view's first sample, and the tab drops the pass
+// as stale: the new view's samples start over, so its frame is sample 1 of maxSamples 1 (it
+// was 2: the dropped pass and the next one).
+TEST(ClientSession, CameraChangeBeforeThePassStartsCountsNoExtraSample) {
+    const engine::Scene scene = bunny();
+    ViewerConfig cfg;
+    cfg.frame.width = 32;
+    cfg.frame.height = 32;
+    cfg.home = engine::fitCamera(scene.defaultView(), 45.0f, 1.0f);
+    cfg.maxSamples = 1;
+    ClientSession* session = nullptr;
+    std::atomic<int> passes{0};
+    std::atomic<bool> armed{false};
+    cfg.beforePass = [&] {
+        ++passes;
+        if (!armed.exchange(false)) return;
+        CameraFrame c = cfg.home;
+        c.fovDeg = 30.0f;
+        session->handle(json{
+            {"type", "camera"},
+            {"eye", {c.eye.x, c.eye.y, c.eye.z}},
+            {"at", {c.at.x, c.at.y, c.at.z}},
+            {"up", {c.up.x, c.up.y, c.up.z}},
+            {"fov",
+             c.fovDeg}}.dump());
+    };
+    Capture cap;
+    ClientSession s(scene, cfg, cap.output());
+    session = &s;
+    ASSERT_TRUE(eventually([&] { return s.idle(); }));
+    ASSERT_EQ(cap.count(), 1u);
+    // Settings restart the view; the pass for them is overtaken by the camera change.
+    armed = true;
+    s.handle(R"({"type":"settings","mesh":{"integrator":"eyelight"}})");
+    ASSERT_TRUE(eventually([&] { return !armed && s.idle(); }));
+    s.handle(json{{"type", "ack"}, {"frame", cap.frame(0)["id"]}}.dump());
+    ASSERT_EQ(cap.count(), 2u);
+    EXPECT_EQ(cap.frame(1)["camera"]["fov"], 30.0);
+    EXPECT_EQ(cap.frame(1)["samples"], 1);
+    EXPECT_GE(passes.load(), 3);  // the first frame, the overtaken pass, the new view's
 }
 
 TEST(ClientSession, BadMessagesChangeNothing) {
