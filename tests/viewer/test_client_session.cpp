@@ -54,6 +54,26 @@ engine::Scene bunny() {
     return engine::open({std::string(RTFACT_DATASETS) + "/meshes/bunny.ply"}, o);
 }
 
+// A 32x32 tab that stops at one sample.
+ViewerConfig oneSampleConfig(const engine::Scene& scene) {
+    ViewerConfig cfg;
+    cfg.frame.width = 32;
+    cfg.frame.height = 32;
+    cfg.home = engine::fitCamera(scene.defaultView(), 45.0f, 1.0f);
+    cfg.maxSamples = 1;
+    return cfg;
+}
+
+// The page's camera message for c.
+std::string cameraMessage(const CameraFrame& c) {
+    return json{{"type", "camera"},
+                {"eye", {c.eye.x, c.eye.y, c.eye.z}},
+                {"at", {c.at.x, c.at.y, c.at.z}},
+                {"up", {c.up.x, c.up.y, c.up.z}},
+                {"fov", c.fovDeg}}
+        .dump();
+}
+
 }  // namespace
 
 TEST(ClientSession, FramesWaitForTheAckAndOnlyTheNewestWaits) {
@@ -79,12 +99,7 @@ TEST(ClientSession, FramesWaitForTheAckAndOnlyTheNewestWaits) {
     // A new camera drops what waits for the old one: after the ack only frames of the new camera come.
     CameraFrame c = cfg.home;
     c.fovDeg = 30.0f;
-    s.handle(json{{"type", "camera"},
-                  {"eye", {c.eye.x, c.eye.y, c.eye.z}},
-                  {"at", {c.at.x, c.at.y, c.at.z}},
-                  {"up", {c.up.x, c.up.y, c.up.z}},
-                  {"fov", c.fovDeg}}
-                 .dump());
+    s.handle(cameraMessage(c));
     ASSERT_TRUE(eventually([&] { return s.idle(); }));
     s.handle(json{{"type", "ack"}, {"frame", cap.frame(1)["id"]}}.dump());
     ASSERT_EQ(cap.count(), 3u);
@@ -98,11 +113,7 @@ TEST(ClientSession, FramesWaitForTheAckAndOnlyTheNewestWaits) {
 // was 2: the dropped pass and the next one).
 TEST(ClientSession, CameraChangeBeforeThePassStartsCountsNoExtraSample) {
     const engine::Scene scene = bunny();
-    ViewerConfig cfg;
-    cfg.frame.width = 32;
-    cfg.frame.height = 32;
-    cfg.home = engine::fitCamera(scene.defaultView(), 45.0f, 1.0f);
-    cfg.maxSamples = 1;
+    ViewerConfig cfg = oneSampleConfig(scene);
     ClientSession* session = nullptr;
     std::atomic<int> passes{0};
     std::atomic<bool> armed{false};
@@ -111,13 +122,7 @@ TEST(ClientSession, CameraChangeBeforeThePassStartsCountsNoExtraSample) {
         if (!armed.exchange(false)) return;
         CameraFrame c = cfg.home;
         c.fovDeg = 30.0f;
-        session->handle(json{
-            {"type", "camera"},
-            {"eye", {c.eye.x, c.eye.y, c.eye.z}},
-            {"at", {c.at.x, c.at.y, c.at.z}},
-            {"up", {c.up.x, c.up.y, c.up.z}},
-            {"fov",
-             c.fovDeg}}.dump());
+        session->handle(cameraMessage(c));
     };
     Capture cap;
     ClientSession s(scene, cfg, cap.output());
@@ -137,11 +142,7 @@ TEST(ClientSession, CameraChangeBeforeThePassStartsCountsNoExtraSample) {
 
 TEST(ClientSession, BadMessagesChangeNothing) {
     const engine::Scene scene = bunny();
-    ViewerConfig cfg;
-    cfg.frame.width = 32;
-    cfg.frame.height = 32;
-    cfg.home = engine::fitCamera(scene.defaultView(), 45.0f, 1.0f);
-    cfg.maxSamples = 1;
+    ViewerConfig cfg = oneSampleConfig(scene);
     Capture cap;
     ClientSession s(scene, cfg, cap.output());
     ASSERT_TRUE(eventually([&] { return s.idle(); }));
