@@ -75,19 +75,22 @@ RenderSession::RenderSession(Scene scene, Settings settings, FrameOptions frame,
 
 RenderSession::~RenderSession() = default;
 
+void RenderSession::restartLocked() {
+    ++generation_;
+    cancel_.store(true);
+}
+
 void RenderSession::setCamera(const CameraFrame& camera) {
     std::lock_guard l(state_);
     camera_ = camera;
-    ++generation_;
-    cancel_.store(true);
+    restartLocked();
 }
 
 void RenderSession::setSettings(const Settings& settings) {
     std::lock_guard l(state_);
     settings_ = settings;
-    ++generation_;
     ++settingsGeneration_;
-    cancel_.store(true);
+    restartLocked();
 }
 
 void RenderSession::setScale(int scale) {
@@ -95,16 +98,14 @@ void RenderSession::setScale(int scale) {
     std::lock_guard l(state_);
     if (scale == scale_) return;
     scale_ = scale;
-    ++generation_;
-    cancel_.store(true);
+    restartLocked();
 }
 
 void RenderSession::cancel() { cancel_.store(true); }
 
 void RenderSession::restart() {
     std::lock_guard l(state_);
-    ++generation_;
-    cancel_.store(true);
+    restartLocked();
 }
 
 void RenderSession::onFrame(std::function<void(const Frame&)> f) {

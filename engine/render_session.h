@@ -101,6 +101,9 @@ class RenderSession {
     Stats counters() const;
 
    private:
+    // A new generation (the accumulation starts over at the next pass) and the pass in
+    // flight cancelled; state_ held.
+    void restartLocked();
     struct Snapshot;
     Scene scene_;
     FrameOptions opts_;

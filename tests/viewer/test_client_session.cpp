@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "apps/view/client_session.h"
+#include "tests/viewer/camera_message.h"
 
 using namespace rtfact;
 using namespace rtfact::viewer;
@@ -64,16 +65,6 @@ ViewerConfig oneSampleConfig(const engine::Scene& scene) {
     return cfg;
 }
 
-// The page's camera message for c.
-std::string cameraMessage(const CameraFrame& c) {
-    return json{{"type", "camera"},
-                {"eye", {c.eye.x, c.eye.y, c.eye.z}},
-                {"at", {c.at.x, c.at.y, c.at.z}},
-                {"up", {c.up.x, c.up.y, c.up.z}},
-                {"fov", c.fovDeg}}
-        .dump();
-}
-
 }  // namespace
 
 TEST(ClientSession, FramesWaitForTheAckAndOnlyTheNewestWaits) {
@@ -99,7 +90,7 @@ TEST(ClientSession, FramesWaitForTheAckAndOnlyTheNewestWaits) {
     // A new camera drops what waits for the old one: after the ack only frames of the new camera come.
     CameraFrame c = cfg.home;
     c.fovDeg = 30.0f;
-    s.handle(cameraMessage(c));
+    s.handle(cameraMessage(c).dump());
     ASSERT_TRUE(eventually([&] { return s.idle(); }));
     s.handle(json{{"type", "ack"}, {"frame", cap.frame(1)["id"]}}.dump());
     ASSERT_EQ(cap.count(), 3u);
@@ -122,7 +113,7 @@ TEST(ClientSession, CameraChangeBeforeThePassStartsCountsNoExtraSample) {
         if (!armed.exchange(false)) return;
         CameraFrame c = cfg.home;
         c.fovDeg = 30.0f;
-        session->handle(cameraMessage(c));
+        session->handle(cameraMessage(c).dump());
     };
     Capture cap;
     ClientSession s(scene, cfg, cap.output());

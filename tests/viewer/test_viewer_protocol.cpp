@@ -16,6 +16,7 @@
 #include "apps/view/viewer_server.h"
 #include "core/render/image_io.h"
 #include "tests/common/image_compare.h"
+#include "tests/viewer/camera_message.h"
 
 using namespace rtfact;
 using namespace rtfact::viewer;
@@ -51,13 +52,6 @@ CameraFrame otherCamera(const engine::Scene& scene) {
     engine::DefaultView v = scene.defaultView();
     v.viewDir = {-0.7f, 0.5f, -0.6f};
     return engine::fitCamera(v, 40.0f, float(W) / float(H));
-}
-
-json cameraMessage(const CameraFrame& c, bool moving = false) {
-    json j = cameraJson(c);
-    j["type"] = "camera";
-    j["moving"] = moving;
-    return j;
 }
 
 bool sameCamera(const json& meta, const CameraFrame& c) { return meta["camera"] == cameraJson(c); }
