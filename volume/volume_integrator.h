@@ -152,8 +152,9 @@ struct VolumeIntegrator {
     }
     // The same from the gradient bricks (VolumeScene::gradients, not null), for p in cell
     // `cell` of brick `brick`: the trilinear interpolation of the cell's eight central
-    // differences, 8 (u8), 16 (u16) or 24 (f32) gathers and a brick lookup instead of six
-    // trilinear samples.
+    // differences: a brick lookup and the cell's four rows of x-adjacent entries
+    // (fetchEntryPair: 8 (u8), 16 (u16) or 24 (f32) gathered words) instead of six trilinear
+    // samples.
     template <int W, class Scene>
     static RTFACT_INLINE Vec3<W> gradientFromBricks(const Scene& s, const Vec3<W>& p,
                                                     const Packet<W, int32_t> (&cell)[3],
@@ -170,16 +171,10 @@ struct VolumeIntegrator {
             const int off = ((r & 1) * E + (r >> 1) * E * E) * B;
             P g0[3], g1[3];
             if constexpr (B == 3) {
-                for (int a = 0; a < 3; ++a) {
-                    g0[a] = gather(s.gradients->values.data(), base + I(off + a));
-                    g1[a] = gather(s.gradients->values.data(), base + I(off + B + a));
-                }
+                fetchEntryPair<3, W>(s.gradients->values.data() + off, base, g0, g1);
             } else {
                 I w0[B], w1[B], d0[3], d1[3];
-                for (int k = 0; k < B; ++k) {
-                    w0[k] = gather(s.gradients->entries.data(), base + I(off + k));
-                    w1[k] = gather(s.gradients->entries.data(), base + I(off + B + k));
-                }
+                fetchEntryPair<B, W>(s.gradients->entries.data() + off, base, w0, w1);
                 GradientBricks::decode<B>(w0, d0);
                 GradientBricks::decode<B>(w1, d1);
                 for (int a = 0; a < 3; ++a) g0[a] = toFloat(d0[a]), g1[a] = toFloat(d1[a]);

@@ -277,6 +277,73 @@ RTFACT_INLINE void fetchCube(const uint8_t* base, const Packet<W, int32_t>& idx,
     }
 }
 
+// Per lane the 2B consecutive 32-bit words at base + idx[i], two adjacent entries of B words
+// (the gradient bricks' cell corners x and x + 1): first[k] = word k, second[k] = word B + k.
+// AVX2: one 64-bit (B = 1, 3: per pair of words) or 128-bit (B = 2) load per lane instead of
+// 2B gathers, as for the voxels' pairs (Zen 5: the gathers' micro-ops cost more than the
+// per-lane loads); AVX-512: 64-bit gathers (half the elements); scalar: per lane.
+template <int B, int W, class T>
+RTFACT_INLINE void fetchEntryPair(const T* base, const Packet<W, int32_t>& idx, Packet<W, T> (&first)[B],
+                                  Packet<W, T> (&second)[B]) {
+    static_assert(sizeof(T) == 4 && B >= 1 && B <= 3);
+    using I = Packet<W, int32_t>;
+    if constexpr (I::C > 1) {
+        using PC = typename Packet<W, T>::ChunkPacket;
+        for (int c = 0; c < I::C; ++c) {
+            PC f[B], s[B];
+            fetchEntryPair<B, PC::size>(base, idx.chunk(c), f, s);
+            for (int k = 0; k < B; ++k) first[k].chunk(c) = f[k], second[k].chunk(c) = s[k];
+        }
+        return;
+    }
+#if RTFACT_NATIVE_WIDTH == 8
+    if constexpr (W == 8 && B == 2) {
+        using V = simd::nvec<T, 8>;
+        alignas(32) int32_t ix[8];
+        _mm256_store_si256((__m256i*)ix, (__m256i)idx.c[0]);
+        // lanes i and i + 4 side by side, then a 4 x 4 transpose within each 128-bit half
+        auto rows = [&](int i) __attribute__((always_inline)) {
+            return _mm256_loadu2_m128i((const __m128i*)(base + ix[i + 4]), (const __m128i*)(base + ix[i]));
+        };
+        const __m256i r0 = rows(0), r1 = rows(1), r2 = rows(2), r3 = rows(3);
+        const __m256i t0 = _mm256_unpacklo_epi32(r0, r1), t1 = _mm256_unpacklo_epi32(r2, r3);
+        const __m256i t2 = _mm256_unpackhi_epi32(r0, r1), t3 = _mm256_unpackhi_epi32(r2, r3);
+        first[0].c[0] = (V)_mm256_unpacklo_epi64(t0, t1);
+        first[1].c[0] = (V)_mm256_unpackhi_epi64(t0, t1);
+        second[0].c[0] = (V)_mm256_unpacklo_epi64(t2, t3);
+        second[1].c[0] = (V)_mm256_unpackhi_epi64(t2, t3);
+        return;
+    }
+    constexpr int kPairs = 8;
+    using Wide = __m256i;
+    auto pairs = [](const T* b, const auto& i, auto& lo, auto& hi) __attribute__((always_inline)) {
+        loadDwordPairs8(b, (__m256i)i.c[0], lo, hi);
+    };
+#elif RTFACT_NATIVE_WIDTH >= 16
+    constexpr int kPairs = 16;
+    using Wide = __m512i;
+    auto pairs = [](const T* b, const auto& i, auto& lo, auto& hi) __attribute__((always_inline)) {
+        gatherEntryPairs(b, i.c[0], lo, hi);
+    };
+#else
+    constexpr int kPairs = 0;
+    using Wide = int;
+    auto pairs = [](const T*, const auto&, auto&, auto&) {};
+#endif
+    if constexpr (W == kPairs) {
+        // words (0, 1), (2, 3), (4, 5): one 64-bit fetch per lane each
+        using V = simd::nvec<T, W>;
+        Wide w[2 * B];
+        for (int k = 0; k < B; ++k) pairs(base + 2 * k, idx, w[2 * k], w[2 * k + 1]);
+        for (int k = 0; k < B; ++k) first[k].c[0] = (V)w[k], second[k].c[0] = (V)w[B + k];
+        return;
+    }
+    for (int k = 0; k < B; ++k) {
+        first[k] = gather(base, idx + I(k));
+        second[k] = gather(base, idx + I(B + k));
+    }
+}
+
 // One transfer-function entry per lane: r, g, b, a as four halves in 64 bits (half_float.h)
 // at base[idx], one 64-bit fetch per lane (AVX2: scalar loads); the halves are sorted by
 // channel with byte and dword shuffles, then converted with F16C.

@@ -1,8 +1,8 @@
 // Gradient bricks (volume/gradient_bricks.h), u8, u16 and f32: their entries decode to the
 // clamped central differences of the voxels (brute force over BrickedVolume::stored), the
 // gradient read from them equals the six-sample gradient at random positions (widths 1 and
-// native, brick faces and the grid's border included), and shaded images with and without
-// them match.
+// native, brick faces and the grid's border included), their per-lane fetch equals scalar
+// reads, and shaded images with and without them match.
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -18,6 +18,7 @@
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_scene.h"
+#include "volume/voxel_gather.h"
 
 using namespace rtfact;
 using namespace rtfact::volume;
@@ -183,6 +184,40 @@ void checkEqualsSixSamples() {
                 ASSERT_NEAR(fast[a][i], six[a][i], 1e-5f * maxOf<T>())
                     << "lane " << i << " axis " << a << " at " << q.x[i] << "," << q.y[i] << "," << q.z[i];
     }
+}
+
+// fetchEntryPair (the gradient's per-lane reads of two adjacent entries) against scalar reads:
+// every entry size, 32-bit integers and floats, widths 1, native and multi-chunk, odd and even
+// (unaligned) word offsets and repeated lanes.
+template <int B, int W, class T>
+void checkEntryPairFetch() {
+    std::vector<T> words(1000);
+    for (size_t i = 0; i < words.size(); ++i) words[i] = T(int32_t(i * 2654435761u % 100003u) - 50000);
+    std::mt19937 rng(uint32_t(17 * B + W));
+    std::uniform_int_distribution<int32_t> u(0, int32_t(words.size()) - 2 * B);
+    for (int it = 0; it < 50; ++it) {
+        Packet<W, int32_t> idx;
+        for (int i = 0; i < W; ++i) idx[i] = it == 0 ? 5 : u(rng);  // 5: every lane the same
+        Packet<W, T> first[B], second[B];
+        fetchEntryPair<B, W>(words.data(), idx, first, second);
+        for (int i = 0; i < W; ++i)
+            for (int k = 0; k < B; ++k) {
+                ASSERT_EQ(first[k][i], words[size_t(idx[i] + k)]) << "B " << B << " W " << W << " lane " << i;
+                ASSERT_EQ(second[k][i], words[size_t(idx[i] + B + k)]) << "B " << B << " W " << W << " lane " << i;
+            }
+    }
+}
+template <int W>
+void checkEntryPairFetches() {
+    checkEntryPairFetch<1, W, int32_t>();
+    checkEntryPairFetch<2, W, int32_t>();
+    checkEntryPairFetch<3, W, float>();
+    checkEntryPairFetch<1, W, float>();
+}
+TEST(GradientBricks, EntryPairFetchEqualsScalarReads) {
+    checkEntryPairFetches<1>();
+    checkEntryPairFetches<kW>();
+    checkEntryPairFetches<64>();
 }
 
 TEST(GradientBricks, EqualSixSampleGradientWidth1) {
