@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/simd/native.h"
 #include "volume/brick_volume.h"
 
 namespace rtfact::volume {
@@ -39,7 +40,7 @@ struct GradientBricks {
     // The differences of an entry (words w), for I = int32_t or Packet<W, int32_t>: fields
     // sign-extended by a shift to the top bits and an arithmetic shift down.
     template <int Bytes, class I>
-    static void decode(const I (&w)[Bytes], I (&g)[3]) {
+    static RTFACT_INLINE void decode(const I (&w)[Bytes], I (&g)[3]) {
         if constexpr (Bytes == 1) {
             for (int a = 0; a < 3; ++a) g[a] = (w[0] << (22 - 10 * a)) >> 22;
         } else {

@@ -191,7 +191,7 @@ struct VolumeIntegrator {
     // Headlight Blinn-Phong with the surface normal from the gradient; lanes without a
     // meaningful gradient stay unshaded.
     template <int W>
-    static Packet<W> shadeFactor(const Vec3<W>& grad, const Vec3<W>& dir) {
+    static RTFACT_INLINE Packet<W> shadeFactor(const Vec3<W>& grad, const Vec3<W>& dir) {
         using P = Packet<W>;
         const P g2 = dot(grad, grad);
         const P c = abs(dot(grad, dir)) / sqrt(max(g2, P(1e-30f)));
