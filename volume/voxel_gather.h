@@ -313,31 +313,23 @@ RTFACT_INLINE void fetchEntryPair(const T* base, const Packet<W, int32_t>& idx, 
         second[0].c[0] = (V)_mm256_unpacklo_epi64(t2, t3);
         second[1].c[0] = (V)_mm256_unpackhi_epi64(t2, t3);
         return;
-    }
-    constexpr int kPairs = 8;
-    using Wide = __m256i;
-    auto pairs = [](const T* b, const auto& i, auto& lo, auto& hi) __attribute__((always_inline)) {
-        loadDwordPairs8(b, (__m256i)i.c[0], lo, hi);
-    };
-#elif RTFACT_NATIVE_WIDTH >= 16
-    constexpr int kPairs = 16;
-    using Wide = __m512i;
-    auto pairs = [](const T* b, const auto& i, auto& lo, auto& hi) __attribute__((always_inline)) {
-        gatherEntryPairs(b, i.c[0], lo, hi);
-    };
-#else
-    constexpr int kPairs = 0;
-    using Wide = int;
-    auto pairs = [](const T*, const auto&, auto&, auto&) {};
-#endif
-    if constexpr (W == kPairs) {
-        // words (0, 1), (2, 3), (4, 5): one 64-bit fetch per lane each
-        using V = simd::nvec<T, W>;
-        Wide w[2 * B];
-        for (int k = 0; k < B; ++k) pairs(base + 2 * k, idx, w[2 * k], w[2 * k + 1]);
-        for (int k = 0; k < B; ++k) first[k].c[0] = (V)w[k], second[k].c[0] = (V)w[B + k];
+    } else if constexpr (W == 8) {
+        // words (0, 1), (2, 3), (4, 5): one 64-bit load per lane each
+        __m256i w[2 * B];
+        for (int k = 0; k < B; ++k) loadDwordPairs8(base + 2 * k, (__m256i)idx.c[0], w[2 * k], w[2 * k + 1]);
+        for (int k = 0; k < B; ++k) first[k].c[0] = (simd::nvec<T, 8>)w[k], second[k].c[0] = (simd::nvec<T, 8>)w[B + k];
         return;
     }
+#elif RTFACT_NATIVE_WIDTH >= 16
+    if constexpr (W == 16) {
+        // the same word pairs by 64-bit gathers
+        __m512i w[2 * B];
+        for (int k = 0; k < B; ++k) gatherEntryPairs(base + 2 * k, idx.c[0], w[2 * k], w[2 * k + 1]);
+        for (int k = 0; k < B; ++k)
+            first[k].c[0] = (simd::nvec<T, 16>)w[k], second[k].c[0] = (simd::nvec<T, 16>)w[B + k];
+        return;
+    }
+#endif
     for (int k = 0; k < B; ++k) {
         first[k] = gather(base, idx + I(k));
         second[k] = gather(base, idx + I(B + k));
