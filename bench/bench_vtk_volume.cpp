@@ -138,6 +138,13 @@ VtkVolumePeer::VtkVolumePeer(const VtkVolumeView& view) : impl_(std::make_unique
         const float u = view.tf.normalized ? p.x : (p.x - lo) / (hi - lo);
         if (u >= 0.0f && u <= 1.0f) m.opacity->AddPoint(storedOf(u), std::clamp(p.a, 0.0f, 1.0f));
     }
+    // MIP: VTK's pixel is colour(max) * opacity(max) with alpha opacity(max); ours is the TF
+    // colour of the maximum, opaque. Opacity 1 over the whole range gives both the same picture.
+    if (view.mip) {
+        m.opacity->RemoveAllPoints();
+        m.opacity->AddPoint(storedOf(0.0f), 1.0);
+        m.opacity->AddPoint(storedOf(1.0f), 1.0);
+    }
     m.property->SetColor(m.color);
     m.property->SetScalarOpacity(m.opacity);
     m.property->SetInterpolationTypeToLinear();
@@ -157,7 +164,10 @@ VtkVolumePeer::VtkVolumePeer(const VtkVolumeView& view) : impl_(std::make_unique
 
     // The same step in world units at every render, one ray per pixel.
     m.mapper->SetInputData(m.data);
-    m.mapper->SetBlendModeToComposite();
+    if (view.mip)
+        m.mapper->SetBlendModeToMaximumIntensity();
+    else
+        m.mapper->SetBlendModeToComposite();
     m.mapper->AutoAdjustSampleDistancesOff();
     m.mapper->LockSampleDistanceToInputSpacingOff();
     m.mapper->SetSampleDistance(float(view.stepVoxels * voxel));

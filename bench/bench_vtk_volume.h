@@ -26,6 +26,7 @@ struct VtkVolumeView {
     std::pair<float, float> window;  // data units, as our table's
     float stepVoxels = 1.0f;
     bool shaded = false;  // headlight Blinn-Phong like our `shaded` mode (not identical)
+    bool mip = false;     // maximum intensity projection (its blend mode), opacity 1 like our `mip`
     CameraFrame camera;
     int width = 0, height = 0;
 };

@@ -32,8 +32,9 @@ check "VTK ratio" has '^met +17: >= 5x VTK FixedPoint, head CT \(1T / 2T\) 6.32 
 check "PSNR over VTK" has '^met +17: PSNR >= VTK.s against the fine-step reference, bonsai CT \(dB over VTK\) 11.8$' full.txt
 check "phantom table row" has '^met +17: 512\^3 u16 translucent phantom <= 150 ms, 2T \(ms\) 113$' full.txt
 check "every-step rate" has '^missed +17: >= 300 Msamples/s per core, 512\^3 phantom, every step \(Msamples/s\) 209$' full.txt
-check "counts" has '^== 31 met, 6 missed, 3 not in this run$' full.txt
+check "counts" has '^== 31 met, 6 missed, 6 not in this run$' full.txt
 check "no shaded runs then: n/a" has '^n/a +17: shaded DVR >= 5x VTK FixedPoint shaded, tooth CT \(1T / 2T\) - / -$' full.txt
+check "no MIP runs then: n/a" has '^n/a +17: MIP >= 5x VTK FixedPoint MIP, bonsai CT \(1T / 2T\) - / -$' full.txt
 
 # Sections not run (bench-figures --only volume): their targets are n/a, not missed; wall
 # clock (no --cpu-clock): no clock note. A LoD quality under 30 dB does not count.
@@ -54,7 +55,7 @@ check "absent section is n/a" has '^n/a +16: primary rays >= 1.0x Embree, wide B
 check "LoD under 30 dB left out" has '^met +16: LoD >= 10x Embree at >= 30 dB, 32M dragon, 2T \(best ratio at 31.0 dB\) 10.8$' partial.txt
 check "build rate from points/s" has '^met +16: LoD build >= 10M points/s, 2T, 32M dragon \(first build\) \(M points/s\) 16$' partial.txt
 check "wall clock: no clock note" has '^met +16: 2 threads >= 1.8x 1 thread, points full detail, 32M dragon \(speed-up\) 2$' partial.txt
-check "partial counts" has '^== 3 met, 0 missed, 37 not in this run$' partial.txt
+check "partial counts" has '^== 3 met, 0 missed, 40 not in this run$' partial.txt
 
 # No LoD quality reaches 30 dB: missed, and said so.
 {
@@ -94,6 +95,21 @@ check "every-step rate from the table" has '^met +17: >= 300 Msamples/s per core
 "$targets" shaded.figures >shaded.txt 2>&1
 check "shaded: the worse thread count misses" has '^missed +17: shaded DVR >= 5x VTK FixedPoint shaded, head CT \(1T / 2T\) 5.21 / 4.93$' shaded.txt
 check "shaded: not the unshaded target" has '^n/a +17: >= 5x VTK FixedPoint, head CT \(1T / 2T\) - / -$' shaded.txt
+
+# MIP against VTK's maximum intensity blend (since session 45), both thread counts judged.
+{
+  echo "== rtfact-bench figures: Test CPU, AVX2 CPU, build ISA native, 2 cores, load 0 0 0, 2026-01-01 00:00 UTC, commit 0000000"
+  echo "-- volume: tooth_103x94x161_uint8.mhd MIP vs VTK"
+  echo "   threads=1 rtfact_ms=102.8 vtk_ms=645.0 vtk/rtfact=6.27x"
+  echo "   threads=2 rtfact_ms=72.2 vtk_ms=443.7 vtk/rtfact=6.14x"
+  echo "-- volume: bonsai_ct.nii.gz MIP vs VTK"
+  echo "   threads=1 rtfact_ms=136.8 vtk_ms=744.4 vtk/rtfact=5.44x"
+  echo "   threads=2 rtfact_ms=150.0 vtk_ms=692.2 vtk/rtfact=4.61x"
+} >mip.figures
+"$targets" mip.figures >mip.txt 2>&1
+check "MIP: met at both thread counts" has '^met +17: MIP >= 5x VTK FixedPoint MIP, tooth CT \(1T / 2T\) 6.27 / 6.14$' mip.txt
+check "MIP: the worse thread count misses" has '^missed +17: MIP >= 5x VTK FixedPoint MIP, bonsai CT \(1T / 2T\) 5.44 / 4.61$' mip.txt
+check "MIP: not the shaded target" has '^n/a +17: shaded DVR >= 5x VTK FixedPoint shaded, tooth CT \(1T / 2T\) - / -$' mip.txt
 
 # Bad input: one line naming the file and the problem, exit 1; bad usage exit 2.
 "$targets" "$work/missing.txt" >out.txt 2>err.txt
