@@ -20,6 +20,14 @@
 
 namespace rtfact::bench {
 
+// A command-line error: CLI11's message, exit status 2 (bad usage) like rtfact's; --help: 0.
+// (CLI::App and CLI::ParseError as template parameters: CLI11 is not included here, where
+// X11's `Success` macro may already be defined.)
+template <class App, class ParseError>
+int usageExit(const App& app, const ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+}
+
 using Clock = std::chrono::steady_clock;
 inline double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();

@@ -8,9 +8,13 @@
 // sample, sampling at t = step * k like VolumeRender, with
 // the same TF lookup table and early termination; no shadow rays on either side. Its
 // grid's active voxels are those the TF makes visible (the information our macrocells
-// get), or the file's own tree for .vdb input.
+// get), or the file's own tree for .vdb input. In --mode iso the OpenVDB peer is its
+// level-set ray caster instead (VdbIsoCaster), and VTK, whose CPU ray caster has no
+// isosurface blend, is left out.
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
 #include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/RayIntersector.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -100,6 +104,84 @@ struct VdbMarcher {
     }
 };
 
+// The isosurface peer: OpenVDB's level-set ray caster (LevelSetRayIntersector, the primary
+// rays of tools::LevelSetRayTracer: hierarchical DDA over the narrow band, the crossing by
+// linear interpolation) on a level set of the volume at the isovalue (tools::levelSetRebuild),
+// shaded as VolumeIntegrator's iso mode: the TF colour at the isovalue times the headlight
+// term of the surface normal.
+// Rays are clipped to the volume's box, as ours are: where the box cuts the surface (the
+// bonsai's pot), the level set closes it outside the box and a ray entering inside the
+// object finds the surface where it leaves, as our march does (else that cap alone cost the
+// peer 14 dB against the reference).
+struct VdbIsoCaster {
+    using Intersector = openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid>;
+    openvdb::FloatGrid::Ptr levelSet;
+    Vec3f color;
+    Vec3f boxLo, boxHi;  // world space
+
+    // Renders rows [y0, y1) into rgba; returns the rays that hit.
+    uint64_t rows(const PinholeCamera& cam, int y0, int y1, std::vector<float>& rgba, const Intersector& inter) const {
+        uint64_t hits = 0;
+        const int w = cam.width();
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                RayPacket<1> r;
+                cam.generate<1>(Packet<1>(float(x) + 0.5f), Packet<1>(float(y) + 0.5f), r);
+                const Vec3f o = r.org.lane(0), d = r.dir.lane(0);
+                float* px = &rgba[(size_t(y) * size_t(w) + size_t(x)) * 4];
+                px[0] = px[1] = px[2] = px[3] = 0;
+                double t0 = 0, t1 = 1e30;
+                for (int a = 0; a < 3; ++a) {
+                    const double inv = 1.0 / double(d[a]);  // +-inf along a slab: the other axes decide
+                    const double ta = (double(boxLo[a]) - o[a]) * inv, tb = (double(boxHi[a]) - o[a]) * inv;
+                    t0 = std::max(t0, std::min(ta, tb));
+                    t1 = std::min(t1, std::max(ta, tb));
+                }
+                if (!(t0 < t1)) continue;
+                const openvdb::math::Ray<double> ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), t0,
+                                                     t1);
+                openvdb::Vec3d xyz, n;
+                if (!inter.intersectsWS(ray, xyz, n)) continue;
+                ++hits;
+                // VolumeIntegrator::shadeFactor: 0.2 + 0.8 c + 0.25 c^20, c = |n.d| / |n|
+                const double n2 = n.lengthSqr();
+                double shade = 1.0;
+                if (n2 > 1e-12) {
+                    const double c = std::fabs(n.dot(ray.dir())) / std::sqrt(n2);
+                    shade = 0.2 + 0.8 * c + 0.25 * std::pow(c, 20.0);
+                }
+                px[0] = float(color.x * shade);
+                px[1] = float(color.y * shade);
+                px[2] = float(color.z * shade);
+                px[3] = 1.0f;
+            }
+        return hits;
+    }
+};
+
+// The level set of v's stored values at isoStored: isoStored - stored is negative inside (above
+// the isovalue), as a level set's interior; outside the volume it is positive (the grid's
+// background, above every voxel's value so that every voxel stays active), so a surface the
+// volume's box cuts is closed there.
+openvdb::FloatGrid::Ptr isoLevelSet(const BrickedVolume& v, float isoStored, const openvdb::math::Transform& xf) {
+    using Dense = openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ>;  // x fastest, as our index
+    Dense dense(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(v.dims[0] - 1, v.dims[1] - 1, v.dims[2] - 1)));
+    float* out = dense.data();
+    tbb::parallel_for(0, v.dims[2], [&](int k) {
+        for (int j = 0; j < v.dims[1]; ++j)
+            for (int i = 0; i < v.dims[0]; ++i)
+                out[(size_t(k) * size_t(v.dims[1]) + size_t(j)) * size_t(v.dims[0]) + size_t(i)] =
+                    isoStored - v.stored(i, j, k);
+    });
+    const float top = *std::max_element(out, out + v.voxelCount());
+    openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(std::max(top, 0.0f) + 1.0f);
+    openvdb::tools::copyFromDense(dense, *grid, 0.0f);
+    grid->setTransform(xf.copy());
+    openvdb::FloatGrid::Ptr ls = openvdb::tools::levelSetRebuild(*grid, 0.0f);
+    ls->setGridClass(openvdb::GRID_LEVEL_SET);
+    return ls;
+}
+
 openvdb::FloatGrid::Ptr toVdb(const BrickedVolume& v, const TFTable& tf) {
     // Stored values; active where the TF makes the voxel visible.
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
@@ -165,10 +247,12 @@ int benchVolume(int argc, char** argv) {
     app.add_option("--level", level, "Window level");
     app.add_option("--step", step, "Step in voxels")->capture_default_str()->check(CLI::PositiveNumber);
     app.add_option("--mode", mode,
-                   "dvr, shaded (VTK shades too) or mip (VTK's maximum intensity blend); OpenVDB's march is DVR "
-                   "only, left out in the others")
+                   "dvr, shaded (VTK shades too), mip (VTK's maximum intensity blend; OpenVDB left out) or iso "
+                   "(OpenVDB's level-set ray caster; VTK's CPU caster has no isosurface blend)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"dvr", "shaded", "mip"}));
+        ->check(CLI::IsMember({"dvr", "shaded", "mip", "iso"}));
+    std::optional<float> iso;
+    app.add_option("--iso", iso, "Isovalue for --mode iso, data units (default: as rtfact volume)");
     app.add_option("--ref-step", refStep, "Step of the RTfact reference for PSNR (0: no reference)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
@@ -192,9 +276,10 @@ int benchVolume(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        return usageExit(app, e);
     }
-    const bool runVtk = !skipPeer && !skipVtk, runVdb = !skipPeer && mode == "dvr";
+    const bool isoMode = mode == "iso";
+    const bool runVtk = !skipPeer && !skipVtk && !isoMode, runVdb = !skipPeer && (mode == "dvr" || isoMode);
     // VTK's render window needs X: without DISPLAY, a private Xvfb for this run.
     std::optional<VirtualDisplay> display;
     if (runVtk) display.emplace(argc, argv);
@@ -231,6 +316,7 @@ int benchVolume(int argc, char** argv) {
     settings.volume.step = step;
     settings.volume.mode = mode;
     settings.volume.adaptiveSteps = !everyStep;
+    settings.volume.iso = iso;
     t0 = Clock::now();
     const engine::BuiltVolume built = engine::builtVolume(sc, settings);
     const double buildMs = msSince(t0);
@@ -252,6 +338,11 @@ int benchVolume(int argc, char** argv) {
     std::printf("cpu: %s, isa %s\n", cpuModel().c_str(), simd::isaName());
     if (!skipPeer && !runVdb)
         std::printf("note: the OpenVDB peer marches DVR only; left out in --mode %s\n", mode.c_str());
+    if (!skipPeer && isoMode)
+        std::printf(
+            "note: VTK's vtkFixedPointVolumeRayCastMapper has no isosurface blend (GPU mappers only); left out; "
+            "OpenVDB = its level-set ray caster, isovalue %g\n",
+            double(built.setup.render.iso));
 
     struct Result {
         double ms = 0;
@@ -283,24 +374,59 @@ int benchVolume(int argc, char** argv) {
 
     openvdb::initialize();
     VdbMarcher peer;
+    VdbIsoCaster isoPeer;
     std::vector<float> peerImage(size_t(w) * size_t(h) * 4);
     auto runPeer = [&](int th) {
         Result best{1e300, 0};
-        openvdb::tools::VolumeRayIntersector<openvdb::FloatGrid> master(*peer.grid);
         for (int f = 0; f < frames; ++f) {
             std::atomic<uint64_t> samples{0};
-            const double ms = timeArena(th, [&] {
-                tbb::parallel_for(tbb::blocked_range<int>(0, h, 4), [&](const tbb::blocked_range<int>& r) {
-                    openvdb::tools::VolumeRayIntersector<openvdb::FloatGrid> inter(master);
-                    samples += peer.rows(cam, r.begin(), r.end(), peerImage, inter);
+            double ms = 0;
+            if (isoMode) {
+                // samples: the rays that hit (the caster's steps are its own)
+                const VdbIsoCaster::Intersector master(*isoPeer.levelSet);
+                ms = timeArena(th, [&] {
+                    tbb::parallel_for(tbb::blocked_range<int>(0, h, 4), [&](const tbb::blocked_range<int>& r) {
+                        const VdbIsoCaster::Intersector inter(master);
+                        samples += isoPeer.rows(cam, r.begin(), r.end(), peerImage, inter);
+                    });
                 });
-            });
+            } else {
+                openvdb::tools::VolumeRayIntersector<openvdb::FloatGrid> master(*peer.grid);
+                ms = timeArena(th, [&] {
+                    tbb::parallel_for(tbb::blocked_range<int>(0, h, 4), [&](const tbb::blocked_range<int>& r) {
+                        openvdb::tools::VolumeRayIntersector<openvdb::FloatGrid> inter(master);
+                        samples += peer.rows(cam, r.begin(), r.end(), peerImage, inter);
+                    });
+                });
+            }
             if (ms < best.ms) best = {ms, samples.load()};
         }
         return best;
     };
 
-    if (runVdb) {
+    if (runVdb && isoMode) {
+        t0 = Clock::now();
+        openvdb::math::Transform::Ptr xf = openvdb::math::Transform::createLinearTransform(double(vol.spacing.x));
+        xf->postTranslate(openvdb::Vec3d(vol.origin.x, vol.origin.y, vol.origin.z));
+        const float isoStored = (built.setup.render.iso - vol.offset) / vol.scale;
+        isoPeer.levelSet = isoLevelSet(vol, isoStored, *xf);
+        if (isoPeer.levelSet->empty()) {
+            const auto [lo, hi] = vol.valueRange();
+            char msg[160];
+            std::snprintf(msg, sizeof msg, "no isosurface at isovalue %g (values lie in [%g, %g]): nothing to compare",
+                          double(built.setup.render.iso), double(lo), double(hi));
+            throw Error(file, msg);
+        }
+        const float k = float(table.size - 1) / (table.hi - table.lo);
+        const size_t i = size_t(std::clamp(isoStored * vol.scale * k + (vol.offset - table.lo) * k + 0.5f, 0.0f,
+                                           float(table.size - 1)));
+        isoPeer.color = Vec3f(table.r[i], table.g[i], table.b[i]);
+        isoPeer.boxLo = vol.origin;
+        isoPeer.boxHi = vol.origin + Vec3f(float(vol.dims[0] - 1), float(vol.dims[1] - 1), float(vol.dims[2] - 1)) *
+                                         vol.spacing;
+        std::printf("openvdb level set: %llu active voxels, built in %.0f ms\n",
+                    (unsigned long long)isoPeer.levelSet->activeVoxelCount(), msSince(t0));
+    } else if (runVdb) {
         t0 = Clock::now();
         if (isVdb) {
             // The file's own sparse tree (values in data units = stored units here).
@@ -372,8 +498,12 @@ int benchVolume(int argc, char** argv) {
         }
         if (runVdb) {
             const Result theirs = runPeer(th);
-            std::printf("%-8s %7d %10.1f %9.2f %11.1f %12llu\n", "openvdb", th, theirs.ms, rays / (theirs.ms * 1e3),
-                        double(theirs.samples) / (theirs.ms * 1e3), (unsigned long long)theirs.samples);
+            if (isoMode)  // the level-set caster's steps are not samples; its hits instead
+                std::printf("%-8s %7d %10.1f %9.2f %11s %12s  %llu rays hit\n", "openvdb", th, theirs.ms,
+                            rays / (theirs.ms * 1e3), "-", "-", (unsigned long long)theirs.samples);
+            else
+                std::printf("%-8s %7d %10.1f %9.2f %11.1f %12llu\n", "openvdb", th, theirs.ms, rays / (theirs.ms * 1e3),
+                            double(theirs.samples) / (theirs.ms * 1e3), (unsigned long long)theirs.samples);
             std::printf("ratio    %7d %10.2fx (openvdb ms / rtfact ms)\n", th, theirs.ms / ours.ms);
             std::snprintf(line, sizeof line, " openvdb_ms=%.1f openvdb/rtfact=%.2fx", theirs.ms, theirs.ms / ours.ms);
             summary += line;
