@@ -418,12 +418,12 @@ int benchVolume(int argc, char** argv) {
             throw Error(file, msg);
         }
         const float k = float(table.size - 1) / (table.hi - table.lo);
-        const size_t i = size_t(std::clamp(isoStored * vol.scale * k + (vol.offset - table.lo) * k + 0.5f, 0.0f,
-                                           float(table.size - 1)));
+        const size_t i = size_t(
+            std::clamp(isoStored * vol.scale * k + (vol.offset - table.lo) * k + 0.5f, 0.0f, float(table.size - 1)));
         isoPeer.color = Vec3f(table.r[i], table.g[i], table.b[i]);
         isoPeer.boxLo = vol.origin;
-        isoPeer.boxHi = vol.origin + Vec3f(float(vol.dims[0] - 1), float(vol.dims[1] - 1), float(vol.dims[2] - 1)) *
-                                         vol.spacing;
+        isoPeer.boxHi =
+            vol.origin + Vec3f(float(vol.dims[0] - 1), float(vol.dims[1] - 1), float(vol.dims[2] - 1)) * vol.spacing;
         std::printf("openvdb level set: %llu active voxels, built in %.0f ms\n",
                     (unsigned long long)isoPeer.levelSet->activeVoxelCount(), msSince(t0));
     } else if (runVdb) {
