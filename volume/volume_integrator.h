@@ -5,6 +5,7 @@
 // same sample positions they would have reached by stepping (skipping changes nothing),
 // and lanes drop out when they leave the box or become opaque.
 #pragma once
+#include <cstring>
 #include <type_traits>
 #include <utility>
 
@@ -351,8 +352,15 @@ struct VolumeIntegrator {
                 Mask<W> empty;
                 P tExit;  // where the lanes' empty cube ends (computed when one is empty)
                 if constexpr (mode == VolumeMode::MIP) {
+                    // the brick's maximum and first entry in one fetch (VolumeScene::mipBricks)
                     const I cid = select(alive, c[0] + c[1] * ncx + c[2] * ncxy, I(0));
-                    empty = alive & (gather(s.cellMax.data(), cid) <= maxv);
+                    I maxBits[1], first[1];
+                    fetchEntryPair<1, W>(s.mipBricks.data(), cid + cid, maxBits, first);
+                    P brickMax;
+                    for (int k = 0; k < P::C; ++k) std::memcpy(&brickMax.c[k], &maxBits[0].c[k], sizeof(brickMax.c[k]));
+                    empty = alive & (brickMax <= maxv);
+                    start = first[0];
+                    haveStart = true;
                     if (any(empty)) tExit = cubeExit(c, I(1), invBrick);
                 } else {
                     // one gather gives the brick, its step multiple, or (sign bit) the

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -127,7 +128,10 @@ struct VolumeScene {
     // the opacity 1 - (1 - a)^m of table m as four halves per entry (half_float.h), so that
     // one 64-bit gather fetches an entry.
     std::vector<uint64_t> rgbaSteps;
-    std::vector<float> cellMax;
+    // MIP: per brick its stored maximum (float bits; infinity: never skipped) and its first
+    // entry in the march's layout (copyStart or brickStart), side by side: one 64-bit fetch a
+    // lane gives the skip test and the sample's brick. Empty in the other modes.
+    std::vector<int32_t> mipBricks;
     // The march prefetches the bricks ahead of its rays where the voxels it reads (the pool
     // in the row layout, else the march's copy) outgrow 8 MB and it waits on memory at
     // every new brick. Measured on Zen 5, 1 thread: the bonsai's 14.5 MB of u8 y-pairs 3%
@@ -189,7 +193,6 @@ struct VolumeScene {
         tfAdd = (v.offset - tf.lo) * k + 0.5f;
         isoStored = (s.iso - v.offset) / v.scale;
         const size_t nc = v.brickCount();
-        cellMax = v.cellHi;
         const size_t ns = nc * 8;
         subFlags.resize(ns);
         std::vector<uint8_t> visible(ns);
@@ -251,8 +254,16 @@ struct VolumeScene {
                     tf.r[e], tf.g[e], tf.b[e], 1.0f - std::pow(1.0f - std::min(tf.a[e], 1.0f), float(1 << m)));
         // MIP skips on stored maxima; a decreasing value map (negative scale) or no
         // skipping: never skip.
-        if (v.scale < 0 || !s.skipping)
-            std::fill(cellMax.begin(), cellMax.end(), std::numeric_limits<float>::infinity());
+        if (s.mode == VolumeMode::MIP) {
+            const bool never = v.scale < 0 || !s.skipping;
+            const int32_t* first = copyVoxels ? copyStart.data() : brickStart;
+            mipBricks.resize(2 * nc);
+            for (size_t b = 0; b < nc; ++b) {
+                const float m = never ? std::numeric_limits<float>::infinity() : v.cellHi[b];
+                std::memcpy(&mipBricks[2 * b], &m, 4);
+                mipBricks[2 * b + 1] = first[b];
+            }
+        }
     }
 
     AABB bounds() const { return {origin + boxLo * spacing, origin + boxHi * spacing}; }
