@@ -52,6 +52,21 @@ namespace {
 
 using namespace rtfact::volume;
 
+// For each pixel of rows [y0, y1): its primary ray (origin, direction) and its RGBA in rgba,
+// cleared to transparent black; the OpenVDB peers render pixel by pixel through this.
+template <class F>
+void forEachPixelRay(const PinholeCamera& cam, int y0, int y1, std::vector<float>& rgba, F&& shade) {
+    const int w = cam.width();
+    for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < w; ++x) {
+            RayPacket<1> r;
+            cam.generate<1>(Packet<1>(float(x) + 0.5f), Packet<1>(float(y) + 0.5f), r);
+            float* px = &rgba[(size_t(y) * size_t(w) + size_t(x)) * 4];
+            px[0] = px[1] = px[2] = px[3] = 0;
+            shade(r.org.lane(0), r.dir.lane(0), px);
+        }
+}
+
 // The peer: OpenVDB intersector + BoxSampler, front-to-back with our TF table.
 struct VdbMarcher {
     openvdb::FloatGrid::Ptr grid;
@@ -67,39 +82,31 @@ struct VdbMarcher {
             acc, grid->transform());
         std::vector<RayT::TimeSpan> spans;
         uint64_t samples = 0;
-        const int w = cam.width();
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x) {
-                RayPacket<1> r;
-                cam.generate<1>(Packet<1>(float(x) + 0.5f), Packet<1>(float(y) + 0.5f), r);
-                const Vec3f o = r.org.lane(0), d = r.dir.lane(0);
-                float* px = &rgba[(size_t(y) * size_t(w) + size_t(x)) * 4];
-                px[0] = px[1] = px[2] = px[3] = 0;
-                RayT ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z));
-                if (!inter.setWorldRay(ray)) continue;
-                inter.hits(spans);
-                float cr = 0, cg = 0, cb = 0, a = 0;
-                for (const auto& sp : spans) {
-                    for (double t = step * std::ceil(sp.t0 / step); t <= sp.t1; t += step) {
-                        const float v = sampler.isSample(inter.getIndexPos(t));
-                        ++samples;
-                        const int i = int(std::clamp(v * tfMul + tfAdd, 0.0f, float(tf->size - 1)));
-                        const float sa = tf->a[size_t(i)];
-                        if (sa <= 0) continue;
-                        const float wgt = (1 - a) * sa;
-                        cr += wgt * tf->r[size_t(i)];
-                        cg += wgt * tf->g[size_t(i)];
-                        cb += wgt * tf->b[size_t(i)];
-                        a += wgt;
-                        if (a >= term) goto done;
-                    }
+        forEachPixelRay(cam, y0, y1, rgba, [&](const Vec3f& o, const Vec3f& d, float* px) {
+            RayT ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z));
+            if (!inter.setWorldRay(ray)) return;
+            inter.hits(spans);
+            float cr = 0, cg = 0, cb = 0, a = 0;
+            for (const auto& sp : spans) {
+                for (double t = step * std::ceil(sp.t0 / step); t <= sp.t1 && a < term; t += step) {
+                    const float v = sampler.isSample(inter.getIndexPos(t));
+                    ++samples;
+                    const int i = int(std::clamp(v * tfMul + tfAdd, 0.0f, float(tf->size - 1)));
+                    const float sa = tf->a[size_t(i)];
+                    if (sa <= 0) continue;
+                    const float wgt = (1 - a) * sa;
+                    cr += wgt * tf->r[size_t(i)];
+                    cg += wgt * tf->g[size_t(i)];
+                    cb += wgt * tf->b[size_t(i)];
+                    a += wgt;
                 }
-            done:
-                px[0] = cr;
-                px[1] = cg;
-                px[2] = cb;
-                px[3] = a;
+                if (a >= term) break;
             }
+            px[0] = cr;
+            px[1] = cg;
+            px[2] = cb;
+            px[3] = a;
+        });
         return samples;
     }
 };
@@ -122,39 +129,31 @@ struct VdbIsoCaster {
     // Renders rows [y0, y1) into rgba; returns the rays that hit.
     uint64_t rows(const PinholeCamera& cam, int y0, int y1, std::vector<float>& rgba, const Intersector& inter) const {
         uint64_t hits = 0;
-        const int w = cam.width();
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x) {
-                RayPacket<1> r;
-                cam.generate<1>(Packet<1>(float(x) + 0.5f), Packet<1>(float(y) + 0.5f), r);
-                const Vec3f o = r.org.lane(0), d = r.dir.lane(0);
-                float* px = &rgba[(size_t(y) * size_t(w) + size_t(x)) * 4];
-                px[0] = px[1] = px[2] = px[3] = 0;
-                double t0 = 0, t1 = 1e30;
-                for (int a = 0; a < 3; ++a) {
-                    const double inv = 1.0 / double(d[a]);  // +-inf along a slab: the other axes decide
-                    const double ta = (double(boxLo[a]) - o[a]) * inv, tb = (double(boxHi[a]) - o[a]) * inv;
-                    t0 = std::max(t0, std::min(ta, tb));
-                    t1 = std::min(t1, std::max(ta, tb));
-                }
-                if (!(t0 < t1)) continue;
-                const openvdb::math::Ray<double> ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), t0,
-                                                     t1);
-                openvdb::Vec3d xyz, n;
-                if (!inter.intersectsWS(ray, xyz, n)) continue;
-                ++hits;
-                // VolumeIntegrator::shadeFactor: 0.2 + 0.8 c + 0.25 c^20, c = |n.d| / |n|
-                const double n2 = n.lengthSqr();
-                double shade = 1.0;
-                if (n2 > 1e-12) {
-                    const double c = std::fabs(n.dot(ray.dir())) / std::sqrt(n2);
-                    shade = 0.2 + 0.8 * c + 0.25 * std::pow(c, 20.0);
-                }
-                px[0] = float(color.x * shade);
-                px[1] = float(color.y * shade);
-                px[2] = float(color.z * shade);
-                px[3] = 1.0f;
+        forEachPixelRay(cam, y0, y1, rgba, [&](const Vec3f& o, const Vec3f& d, float* px) {
+            double t0 = 0, t1 = 1e30;
+            for (int a = 0; a < 3; ++a) {
+                const double inv = 1.0 / double(d[a]);  // +-inf along a slab: the other axes decide
+                const double ta = (double(boxLo[a]) - o[a]) * inv, tb = (double(boxHi[a]) - o[a]) * inv;
+                t0 = std::max(t0, std::min(ta, tb));
+                t1 = std::min(t1, std::max(ta, tb));
             }
+            if (!(t0 < t1)) return;
+            const openvdb::math::Ray<double> ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), t0, t1);
+            openvdb::Vec3d xyz, n;
+            if (!inter.intersectsWS(ray, xyz, n)) return;
+            ++hits;
+            // VolumeIntegrator::shadeFactor: 0.2 + 0.8 c + 0.25 c^20, c = |n.d| / |n|
+            const double n2 = n.lengthSqr();
+            double shade = 1.0;
+            if (n2 > 1e-12) {
+                const double c = std::fabs(n.dot(ray.dir())) / std::sqrt(n2);
+                shade = 0.2 + 0.8 * c + 0.25 * std::pow(c, 20.0);
+            }
+            px[0] = float(color.x * shade);
+            px[1] = float(color.y * shade);
+            px[2] = float(color.z * shade);
+            px[3] = 1.0f;
+        });
         return hits;
     }
 };

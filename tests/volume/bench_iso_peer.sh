@@ -6,33 +6,23 @@
 # about the tooth's share of the rays (763 of 4096), and an isovalue above the data is a
 # one-line error, exit 1; a bad --iso value is bad usage, exit 2.
 # usage: bench_iso_peer.sh RTFACT_BENCH DATASETS_DIR OUT_DIR
-set -uo pipefail
-bench="$1" data="$2" out="$3"
-mkdir -p "$out"
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
+source "$(dirname "$0")/bench_test_lib.sh"
 args=(volume "$data/volumes/tooth_103x94x161_uint8.raw" --size 64x64 --frames 1 --threads 2 --step 1 --mode iso
   --tf "$data/volumes/translucent_ramp_paraview.json")
 
 log="$out/tooth64_iso.txt"
 # No DISPLAY and no Xvfb on the PATH: the run must not need VTK.
-env -u DISPLAY PATH=/nonexistent "$bench" "${args[@]}" --images "$out/tooth64_iso" >"$log" 2>&1
-rc=$?
-cat "$log"
-[ "$rc" -eq 0 ] || fail "rtfact-bench volume --mode iso exited with $rc"
+BENCH_PATH=/nonexistent run_bench "$log" "${args[@]}" --images "$out/tooth64_iso"
 grep -q "^vtk " "$log" && fail "VTK ran in --mode iso"
 grep -q "no isosurface blend" "$log" || fail "no note on VTK"
 grep -q "^openvdb  *2 " "$log" || fail "no 2-thread OpenVDB row"
 hits="$(awk '$1 == "openvdb" && $2 == "2" { for (i = 1; i < NF; ++i) if ($(i + 1) == "rays") print $i }' "$log")"
 [[ "$hits" =~ ^[0-9]+$ ]] || fail "no hit count in the OpenVDB row"
 ((hits >= 600 && hits <= 950)) || fail "OpenVDB hit $hits of 4096 rays (the tooth covers ~770)"
-value() { grep -o "$1=[0-9.]*" "$log" | head -1 | cut -d= -f2; }
-ours="$(value psnr_rtfact_db)" vdb="$(value psnr_openvdb_db)"
+ours="$(value "$log" psnr_rtfact_db)" vdb="$(value "$log" psnr_openvdb_db)"
 [ -n "$ours" ] && [ -n "$vdb" ] || fail "no psnr_rtfact_db / psnr_openvdb_db"
-awk -v v="$ours" 'BEGIN { exit !(v >= 50) }' || fail "PSNR of RTfact's isosurface $ours dB < 50"
-awk -v v="$vdb" 'BEGIN { exit !(v >= 40) }' || fail "PSNR of OpenVDB's isosurface $vdb dB < 40"
+at_least "$ours" 50 "PSNR of RTfact's isosurface"
+at_least "$vdb" 40 "PSNR of OpenVDB's isosurface"
 for f in tooth64_iso_openvdb.png tooth64_iso_rtfact.png tooth64_iso_reference.png; do
   [ -s "$out/$f" ] || fail "--images did not write $f"
 done

@@ -5,13 +5,7 @@
 # instead of linear colours 20 dB, black 14 dB). Without DISPLAY the benchmark starts its
 # own Xvfb, which this also exercises (several at once: each server picks a free display).
 # usage: bench_vtk_peer.sh RTFACT_BENCH DATASETS_DIR OUT_DIR
-set -uo pipefail
-bench="$1" data="$2" out="$3"
-mkdir -p "$out"
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
+source "$(dirname "$0")/bench_test_lib.sh"
 
 if ! command -v Xvfb >/dev/null; then
   echo "SKIP: Xvfb is not installed (apt-get install xvfb; scripts/setup.sh installs it)"
@@ -23,22 +17,15 @@ ramp="$data/volumes/translucent_ramp_paraview.json"
 args=(volume "$tooth" --size 64x64 --frames 1 --threads 2 --step 1 --tf "$ramp")
 
 log="$out/tooth64.txt"
-env -u DISPLAY "$bench" "${args[@]}" --images "$out/tooth64" >"$log" 2>&1
-rc=$?
-[ "$rc" -eq 0 ] || {
-  cat "$log"
-  fail "rtfact-bench volume exited with $rc"
-}
-cat "$log"
-value() { grep -o "$1=[0-9.]*" "$log" | head -1 | cut -d= -f2; }
-vtk_db="$(value psnr_vtk_db)" cast_db="$(value psnr_vtk_cast_db)" nonblack="$(value vtk_nonblack)"
+run_bench "$log" "${args[@]}" --images "$out/tooth64"
+vtk_db="$(value "$log" psnr_vtk_db)" cast_db="$(value "$log" psnr_vtk_cast_db)" nonblack="$(value "$log" vtk_nonblack)"
 [ -n "$vtk_db" ] && [ -n "$cast_db" ] && [ -n "$nonblack" ] || fail "no psnr_vtk_db / psnr_vtk_cast_db / vtk_nonblack"
 grep -q "^vtk  *2 " "$log" || fail "no 2-thread VTK timing row"
 # The tooth covers about a fifth of the frame (19% in RTfact's image).
 awk -v v="$nonblack" 'BEGIN { exit !(v >= 0.1 && v <= 0.4) }' || fail "VTK image non-black fraction $nonblack"
 # Window read-back (after VTK's texture draw; measured 34 dB) and the mapper's own image (55 dB).
-awk -v v="$vtk_db" 'BEGIN { exit !(v >= 30) }' || fail "PSNR of VTK's window image $vtk_db dB < 30"
-awk -v v="$cast_db" 'BEGIN { exit !(v >= 45) }' || fail "PSNR of VTK's cast image $cast_db dB < 45"
+at_least "$vtk_db" 30 "PSNR of VTK's window image"
+at_least "$cast_db" 45 "PSNR of VTK's cast image"
 for f in tooth64_vtk.png tooth64_rtfact.png tooth64_reference.png; do
   [ -s "$out/$f" ] || fail "--images did not write $f"
 done
@@ -48,17 +35,13 @@ done
 # a composite blend would show the box's faces alone (~10 dB). Measured 30 dB (window) and 34
 # dB (cast) at 64x64, where the box's edge pixels weigh most. OpenVDB's march is DVR only.
 mlog="$out/tooth64_mip.txt"
-env -u DISPLAY "$bench" "${args[@]}" --mode mip >"$mlog" 2>&1 || {
-  cat "$mlog"
-  fail "rtfact-bench volume --mode mip failed"
-}
-cat "$mlog"
-mvalue() { grep -o "$1=[0-9.]*" "$mlog" | head -1 | cut -d= -f2; }
-mip_db="$(mvalue psnr_vtk_db)" mip_cast_db="$(mvalue psnr_vtk_cast_db)" mip_nonblack="$(mvalue vtk_nonblack)"
+run_bench "$mlog" "${args[@]}" --mode mip
+mip_db="$(value "$mlog" psnr_vtk_db)" mip_cast_db="$(value "$mlog" psnr_vtk_cast_db)"
+mip_nonblack="$(value "$mlog" vtk_nonblack)"
 [ -n "$mip_db" ] && [ -n "$mip_cast_db" ] && [ -n "$mip_nonblack" ] || fail "MIP: no PSNR / non-black figures"
 awk -v v="$mip_nonblack" 'BEGIN { exit !(v >= 0.35 && v <= 0.6) }' || fail "VTK MIP non-black fraction $mip_nonblack"
-awk -v v="$mip_db" 'BEGIN { exit !(v >= 26) }' || fail "PSNR of VTK's MIP window image $mip_db dB < 26"
-awk -v v="$mip_cast_db" 'BEGIN { exit !(v >= 28) }' || fail "PSNR of VTK's MIP cast image $mip_cast_db dB < 28"
+at_least "$mip_db" 26 "PSNR of VTK's MIP window image"
+at_least "$mip_cast_db" 28 "PSNR of VTK's MIP cast image"
 grep -q "^ratio  *2 " "$mlog" || fail "MIP: no 2-thread ratio row"
 grep -q "^openvdb " "$mlog" && fail "MIP: OpenVDB ran"
 grep -q "OpenVDB peer marches DVR only; left out in --mode mip" "$mlog" || fail "MIP: no note on OpenVDB"
