@@ -124,7 +124,8 @@ VtkVolumePeer::VtkVolumePeer(const VtkVolumeView& view) : impl_(std::make_unique
     // The TF over the window [lo, hi] in data units, moved to stored units
     // (data = stored * scale + offset); clamped outside like our table. Sampled densely
     // (our colours are interpolated in sRGB, then linearised) plus the exact opacity points.
-    const auto [lo, hi] = view.window;
+    // plain names, not a structured binding: the lambdas below capture them (Clang < 16 cannot)
+    const float lo = view.window.first, hi = view.window.second;
     auto storedOf = [&](float u) { return double((lo + u * (hi - lo) - v.offset) / v.scale); };
     auto tfX = [&](float u) { return view.tf.normalized ? u : lo + u * (hi - lo); };
     constexpr int kSamples = 1024;
