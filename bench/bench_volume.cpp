@@ -237,7 +237,7 @@ int benchVolume(int argc, char** argv) {
     float step = 0.5f, fov = 45.0f, refStep = 0.1f;
     int threads = 0, frames = 3, packet = 64;
     std::optional<float> window, level;
-    bool skipPeer = false, skipVtk = false, everyStep = false;
+    bool skipPeer = false, skipVtk = false, everyStep = false, preintegrated = false;
     app.add_option("FILE", file, "Volume file")->required();
     app.add_option("--dims", dims, "Raw dims X,Y,Z");
     app.add_option("--type", type, "Raw type u8|u16|i16|f32");
@@ -272,6 +272,8 @@ int benchVolume(int argc, char** argv) {
     app.add_flag("--no-adaptive-steps", everyStep,
                  "RTfact marches every step in low-opacity bricks too (no 2x/4x steps), as rtfact volume "
                  "--no-adaptive-steps: its per-sample rate");
+    app.add_flag("--preintegrated", preintegrated,
+                 "RTfact composites pre-integrated segments between samples, as rtfact volume --preintegrated");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -315,6 +317,7 @@ int benchVolume(int argc, char** argv) {
     settings.volume.step = step;
     settings.volume.mode = mode;
     settings.volume.adaptiveSteps = !everyStep;
+    settings.volume.preintegrated = preintegrated;
     settings.volume.iso = iso;
     t0 = Clock::now();
     const engine::BuiltVolume built = engine::builtVolume(sc, settings);

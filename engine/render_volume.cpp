@@ -68,6 +68,7 @@ VolumeSetup resolveVolumeSetup(const BrickedVolume& vol, const VolumeSettings& s
     rs.stepVoxels = s.step;
     rs.skipping = s.skipping;
     if (!s.adaptiveSteps) rs.maxStepMultiple = 1;
+    rs.preintegrated = s.preintegrated;
     rs.clipLo = s.clipLo;
     rs.clipHi = s.clipHi;
     if (s.lattice) {

@@ -66,6 +66,9 @@ struct VolumeSettings {
     // Opacity-adaptive steps (dvr, shaded): bricks of low opacity are marched with 2 or 4
     // times the step on the same sample lattice; off: the plain march.
     bool adaptiveSteps = true;
+    // Pre-integrated transfer function (dvr, shaded): each sample composites the segment
+    // from the previous one, the value taken as linear between them.
+    bool preintegrated = false;
     // Data-parallel ranks: samples on the lattice of this world box (docs/mpi.md).
     std::optional<AABB> lattice;
 };

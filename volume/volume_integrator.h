@@ -13,6 +13,7 @@
 #include "core/render/render_counters.h"
 #include "core/simd/chunk_group.h"
 #include "core/util/prefetch.h"
+#include "volume/exp_negative.h"
 #include "volume/volume_scene.h"
 #include "volume/voxel_gather.h"
 
@@ -47,11 +48,11 @@ struct VolumeIntegrator {
         constexpr int G2 = G == 4 ? 2 : G;
         // The mode is fixed at compile time: the other modes' state and branches drop out of
         // the loop, whose values do not fit the registers (fewer of them, fewer spills).
-        auto marchGroups = [&]<int GG, VolumeMode M>() {
+        auto marchGroups = [&]<int GG, VolumeMode M, bool Pre>() {
             for (int k = 0; k < C; k += GG) {
                 Vec3<GG * W> col;
                 Packet<GG * W> alpha, depth;
-                march<GG * W, L, M>(s, chunkGroup<GG * W>(rays.org, k), chunkGroup<GG * W>(rays.dir, k),
+                march<GG * W, L, M, Pre>(s, chunkGroup<GG * W>(rays.org, k), chunkGroup<GG * W>(rays.dir, k),
                                     chunkGroup<GG * W>(rays.tMin, k), chunkGroup<GG * W>(rays.tMax, k),
                                     chunkGroup<GG * W>(active, k), col, alpha, depth, samples, skipped);
                 for (int j = 0; j < GG; ++j) {
@@ -63,9 +64,13 @@ struct VolumeIntegrator {
         };
         auto marchMode = [&]<VolumeMode M>() {
             if constexpr (M == VolumeMode::Iso || (W == 8 && M == VolumeMode::MIP)) {
-                marchGroups.template operator()<G2, M>();
+                marchGroups.template operator()<G2, M, false>();
+            } else if constexpr (M == VolumeMode::MIP) {
+                marchGroups.template operator()<G, M, false>();
+            } else if (s.tfIntegral.empty()) {
+                marchGroups.template operator()<G, M, false>();
             } else {
-                marchGroups.template operator()<G, M>();
+                marchGroups.template operator()<G, M, true>();
             }
         };
         // the settings' mode as a template argument (VolumeMode's values are 0 .. 3)
@@ -210,7 +215,22 @@ struct VolumeIntegrator {
         return toInt(tfEntry<W>(s, v));
     }
 
-    template <int W, VoxelLayout L, VolumeMode mode, class Scene>
+    // The pre-integrated segment colour (r, g, b) and opacity a between TF entries lo < hi
+    // (VolumeScene::tfIntegral: entries lo .. hi - 1), len steps long.
+    template <int W, class Scene>
+    static RTFACT_INLINE void segment(const Scene& s, const Packet<W, int32_t>& lo, const Packet<W, int32_t>& hi,
+                                      const Packet<W>& len, Vec3<W>& rgb, Packet<W>& a) {
+        using P = Packet<W>;
+        using I = Packet<W, int32_t>;
+        const float* t = s.tfIntegral.data();
+        const I il = lo * I(4), ih = hi * I(4);
+        const P dT = gather(t, ih) - gather(t, il);
+        a = P(1.0f) - expNegative<W>(dT / toFloat(hi - lo) * len);
+        const P inv = P(1.0f) / max(dT, P(1e-30f));  // dT 0: no opacity, any colour
+        for (int c = 0; c < 3; ++c) rgb[c] = (gather(t + 1 + c, ih) - gather(t + 1 + c, il)) * inv;
+    }
+
+    template <int W, VoxelLayout L, VolumeMode mode, bool kPre, class Scene>
     void march(const Scene& s, const Vec3<W>& o, const Vec3<W>& d, const Packet<W>& tMin, const Packet<W>& tMax,
                const Mask<W>& act, Vec3<W>& col, Packet<W>& alpha, Packet<W>& depth, uint64_t& samples,
                float& skipped) const {
@@ -261,6 +281,11 @@ struct VolumeIntegrator {
         const I nsx(s.subs[0]), nsxy(s.subs[0] * s.subs[1]);     // sub-brick grid
         P skipAcc(0.0f);
         Packet<W, int32_t> sampleCount(0);
+        // pre-integration: the previous sample's TF entry and index, where it is the sample
+        // just before (not before a jump)
+        I jPrev(0);
+        P kfPrev(0.0f);
+        Mask<W> prevOk(false);
 
         // Per axis, once a ray: the side of a brick the ray leaves by follows inv's sign (an
         // axis the ray runs along, inv +-1e20, gives a far exit, not a near one), and the
@@ -341,6 +366,24 @@ struct VolumeIntegrator {
             const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
             const I c[3] = {cell[0] >> 3, cell[1] >> 3, cell[2] >> 3};
             const I sc[3] = {cell[0] >> 2, cell[1] >> 2, cell[2] >> 2};
+            // Pre-integration: composites lanes m's segments between TF entries j and jp, len
+            // steps long (grad: the gradient at p, for shading).
+            auto compositeSegment = [&](const Mask<W>& m, const I& j, const I& jp, const P& len, auto&& grad)
+                                        __attribute__((always_inline)) {
+                Vec3<W> rgb;
+                P a;
+                segment<W>(s, min(j, jp), max(j, jp) + I(1), len, rgb, a);
+                a = select(m, a, P(0.0f));
+                const Mask<W> contrib = a > P(0.0f);
+                if (any(contrib)) {
+                    if constexpr (mode == VolumeMode::Shaded) rgb = rgb * shadeFactor<W>(grad(), d);
+                    const P w = (P(1.0f) - alpha) * a;
+                    col += rgb * w;
+                    alpha += w;
+                    depth = min(depth, select(contrib, t, P(kInfinity)));
+                }
+                alive = alive & (alpha < term);
+            };
             Mask<W> samp = alive;
             I start(0);
             bool haveStart = false;
@@ -397,6 +440,20 @@ struct VolumeIntegrator {
                     if (any(empty)) tExit = cubeExit(sc, info & I(0x7fffffff), invSub);
                 }
                 if (any(empty)) {
+                    if constexpr (kPre) {
+                        // Lanes entering the empty cube from a sample: the segment up to here,
+                        // whose values may pass visible ones on the way (the cube's own segments
+                        // add nothing: its values stay invisible).
+                        const Mask<W> closing = empty & prevOk;
+                        if (any(closing)) {
+                            sampleCount = sampleCount + select(closing, I(1), I(0));
+                            const I j = toInt(tfEntry<W>(s, sample<W, L>(s, p)));
+                            compositeSegment(closing, j, jPrev, kf - kfPrev, [&] {
+                                return s.gradients ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
+                            });
+                        }
+                        prevOk = andNot(prevOk, empty);
+                    }
                     const P kk = max(sampleIndexAt(tExit), kf + P(1.0f));
                     const P tn = tNear + (kk + P(0.5f)) * dt;
                     skipAcc += select(empty, min(kk, (tFar - tNear) * invDt) - kf, P(0.0f));
@@ -409,7 +466,28 @@ struct VolumeIntegrator {
                 sampleCount = sampleCount + select(samp, I(1), I(0));
                 // sampling lanes have not moved since the brick lookup; the others are masked
                 const P v = haveStart ? sampleCell<W, L>(s, p, cell, start) : sample<W, L>(s, p);
-                if constexpr (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
+                if constexpr (kPre) {
+                    // The segment from the previous sample; a lane's first sample, on entering
+                    // the box or after a jump, takes the lattice point one step before (after a
+                    // jump: in the empty cube, an invisible value).
+                    const I j = toInt(tfEntry<W>(s, v));
+                    I jp = jPrev;
+                    P kp = kfPrev;
+                    const Mask<W> fresh = andNot(samp, prevOk);
+                    if (any(fresh)) {
+                        const P tb = tNear + (kf - P(0.5f)) * dt;
+                        const P vb = sample<W, L>(s, clampToGrid<W>(s, oi + di * tb));
+                        sampleCount = sampleCount + select(fresh, I(1), I(0));
+                        jp = select(fresh, toInt(tfEntry<W>(s, vb)), jp);
+                        kp = select(fresh, kf - P(1.0f), kp);
+                    }
+                    compositeSegment(samp, j, jp, kf - kp, [&] {
+                        return s.gradients ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
+                    });
+                    jPrev = select(samp, j, jPrev);
+                    kfPrev = select(samp, kf, kfPrev);
+                    prevOk = prevOk | samp;
+                } else if constexpr (mode == VolumeMode::DVR || mode == VolumeMode::Shaded) {
                     // TF entries outside [tfVisibleLo, tfVisibleHi) have zero opacity: when no
                     // lane's entry is inside, the sample adds nothing (inside partly visible
                     // sub-bricks most samples are invisible) and the TF fetch is left out.
