@@ -129,7 +129,7 @@ const std::set<std::string>& namesOf(SceneKind k) {
     static const std::set<std::string> mesh{"integrator", "max_depth",  "light",    "material",
                                             "bvh",        "ao_samples", "secondary"};
     static const std::set<std::string> volume{
-        "tf", "mode", "iso", "step", "window", "level", "clip", "no_skip", "no_adaptive_steps"};
+        "tf", "mode", "iso", "step", "window", "level", "clip", "no_skip", "no_adaptive_steps", "preintegrated"};
     static const std::set<std::string> spheres{"integrator"};
     switch (k) {
         case SceneKind::Points:
@@ -183,6 +183,7 @@ void applyVolume(engine::VolumeSettings& s, const std::string& k, py::handle v) 
     if (k == "clip") clipArg(v, s);
     if (k == "no_skip") s.skipping = !flag(v, k);
     if (k == "no_adaptive_steps") s.adaptiveSteps = !flag(v, k);
+    if (k == "preintegrated") s.preintegrated = flag(v, k);
 }
 
 }  // namespace

@@ -53,8 +53,8 @@ struct VolumeIntegrator {
                 Vec3<GG * W> col;
                 Packet<GG * W> alpha, depth;
                 march<GG * W, L, M, Pre>(s, chunkGroup<GG * W>(rays.org, k), chunkGroup<GG * W>(rays.dir, k),
-                                    chunkGroup<GG * W>(rays.tMin, k), chunkGroup<GG * W>(rays.tMax, k),
-                                    chunkGroup<GG * W>(active, k), col, alpha, depth, samples, skipped);
+                                         chunkGroup<GG * W>(rays.tMin, k), chunkGroup<GG * W>(rays.tMax, k),
+                                         chunkGroup<GG * W>(active, k), col, alpha, depth, samples, skipped);
                 for (int j = 0; j < GG; ++j) {
                     r.color.setChunk(k + j, col.chunk(j));
                     r.alpha.chunk(k + j) = alpha.chunk(j);
@@ -369,7 +369,7 @@ struct VolumeIntegrator {
             // Pre-integration: composites lanes m's segments between TF entries j and jp, len
             // steps long (grad: the gradient at p, for shading).
             auto compositeSegment = [&](const Mask<W>& m, const I& j, const I& jp, const P& len, auto&& grad)
-                                        __attribute__((always_inline)) {
+                __attribute__((always_inline)) {
                 Vec3<W> rgb;
                 P a;
                 segment<W>(s, min(j, jp), max(j, jp) + I(1), len, rgb, a);

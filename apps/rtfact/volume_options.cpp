@@ -66,6 +66,9 @@ void VolumeOptions::addTo(CLI::App& cmd) {
     cmd.add_flag("--no-skip", noSkip, "Disable empty-space skipping (for comparisons)");
     cmd.add_flag("--no-adaptive-steps", noAdaptiveSteps,
                  "March low-opacity bricks with the plain step too (no 2x/4x steps)");
+    cmd.add_flag("--preintegrated", settings.preintegrated,
+                 "Pre-integrated TF (dvr, shaded): each step composites the values between two samples, "
+                 "so narrow TF bands stay whole at long steps");
 }
 
 engine::Settings VolumeOptions::toSettings() const {

@@ -41,7 +41,7 @@ def render(scene, camera=None, **settings):
     options of its CLI subcommand: points (integrator, color, lod, lod_quality, normals,
     radius, radius_factor, leaf_size, ao_samples), mesh (integrator, light, material, bvh,
     ao_samples, max_depth, secondary), volume (tf, mode, iso, step, window, level, clip,
-    no_skip, no_adaptive_steps). The GIL is released while rendering.
+    no_skip, no_adaptive_steps, preintegrated). The GIL is released while rendering.
     """
     out = _rtfact.render(scene, camera, **settings)
     if isinstance(out, tuple):

@@ -142,3 +142,21 @@ def test_volume_no_adaptive_steps_equals_cli(tmp_path, cli):
     assert coverage(expected) > 0.05
     assert_images_match(plain, expected, "volume_plain_march", tmp_path)
     assert not np.array_equal(plain, adaptive), "the switch changed nothing: longer steps were expected"
+
+
+def test_volume_preintegrated_equals_cli(tmp_path, cli):
+    """preintegrated=True is the CLI's --preintegrated, and it changes the picture."""
+    vol = blob_volume(np.uint8)
+    nz, ny, nx = vol.shape
+    raw = tmp_path / "blob.raw"
+    vol.tofile(raw)
+    out = tmp_path / "pre.exr"
+    cli("volume", raw, "--dims", f"{nx},{ny},{nz}", "--type", "u8", "-o", out, "--size", f"{SIZE[0]}x{SIZE[1]}",
+        "--tf", "viridis", "--step", "2", "--preintegrated")
+    expected = rtfact.read_image(str(out))
+    scene = rtfact.volume(vol)
+    pre = rtfact.render(scene, size=SIZE, tf="viridis", step=2, preintegrated=True)
+    plain = rtfact.render(scene, size=SIZE, tf="viridis", step=2)
+    assert coverage(expected) > 0.05
+    assert_images_match(pre, expected, "volume_preintegrated", tmp_path)
+    assert not np.array_equal(pre, plain), "the switch changed nothing"
