@@ -92,7 +92,7 @@ void applyPoints(const json& p, engine::PointSettings& s) {
 }
 
 void applyVolume(const json& v, engine::VolumeSettings& s) {
-    onlyKeys(v, "volume", {"mode", "tf", "window", "level", "step", "clipLo", "clipHi", "iso"});
+    onlyKeys(v, "volume", {"mode", "tf", "window", "level", "step", "clipLo", "clipHi", "iso", "preintegrated"});
     if (v.contains("mode")) s.mode = oneOf(v["mode"], "mode", engine::volumeModes());
     if (v.contains("tf")) {
         const json& t = v["tf"];
@@ -124,6 +124,7 @@ void applyVolume(const json& v, engine::VolumeSettings& s) {
     optionalNumber("level", s.level, -1e30, 1e30);
     optionalNumber("iso", s.iso, -1e30, 1e30);
     if (v.contains("step")) s.step = float(number(v["step"], "step", 0.01, 64.0));
+    if (v.contains("preintegrated")) s.preintegrated = boolean(v["preintegrated"], "preintegrated");
     if (v.contains("clipLo")) s.clipLo = vec3(v["clipLo"], "clipLo", 0.0, 1.0);
     if (v.contains("clipHi")) s.clipHi = vec3(v["clipHi"], "clipHi", 0.0, 1.0);
     for (int a = 0; a < 3; ++a)
@@ -242,6 +243,7 @@ json settingsJson(const engine::Settings& s, engine::SceneKind kind) {
         const engine::VolumeSettings& v = s.volume;
         json j = {{"mode", v.mode},
                   {"step", v.step},
+                  {"preintegrated", v.preintegrated},
                   {"clipLo", {v.clipLo.x, v.clipLo.y, v.clipLo.z}},
                   {"clipHi", {v.clipHi.x, v.clipHi.y, v.clipHi.z}}};
         j["tf"] = v.tf ? tfJson(*v.tf) : json(nullptr);

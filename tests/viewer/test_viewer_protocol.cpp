@@ -249,6 +249,29 @@ TEST(ViewerProtocol, VolumeSessionsSendTheHistogramAndTransferFunction) {
     EXPECT_NE(before.bytes, after.bytes);
 }
 
+// The pre-integrated march is a volume setting like the step: the hello states it, turning it
+// on changes the picture (a long step: the plain march's slices differ from the segments'),
+// and a value that is not a boolean is refused.
+TEST(ViewerProtocol, VolumePreintegrationIsASetting) {
+    Served s(kVolume, engine::SceneKind::Volume);
+    WsClient c = s.client();
+    const json hello = c.until("hello");
+    EXPECT_EQ(hello["settings"]["preintegrated"], false);
+    // full-size lossless frames, each rendered after its settings' transfer message
+    const auto full = [](const json& m) { return m["format"] == "png" && m["width"] == m["fullWidth"]; };
+    c.send(json{{"type", "format"}, {"lossless", true}});
+    c.send(R"({"type":"settings","volume":{"step":3}})");
+    c.until("transfer");
+    const FrameMsg before = c.frame(full);
+    c.send(R"({"type":"settings","volume":{"preintegrated":"yes"}})");
+    EXPECT_NE(c.until("error")["message"].get<std::string>().find("preintegrated"), std::string::npos);
+    c.send(R"({"type":"settings","volume":{"preintegrated":true}})");
+    c.until("transfer");
+    const FrameMsg after = c.frame(full);
+    EXPECT_EQ(before.meta["width"], after.meta["width"]);
+    EXPECT_NE(before.bytes, after.bytes);
+}
+
 TEST(ViewerProtocol, EveryRequestNeedsTheToken) {
     Served s(kPoints, engine::SceneKind::Points);
     const int port = s.server->port();

@@ -306,7 +306,8 @@
         select('mode', ch.mode, s.mode, (v) => sendSettings({ mode: v })),
         select('TF preset', ['(default)', ...ch.tf], s.tf && ch.tf.includes(s.tf.name) ? s.tf.name : '(default)',
           (v) => sendSettings({ tf: v === '(default)' ? null : v, window: null, level: null })),
-        range('step (voxels)', 0.1, 4, 0.05, s.step, (v) => sendSettings({ step: v })));
+        range('step (voxels)', 0.1, 4, 0.05, s.step, (v) => sendSettings({ step: v })),
+        check('pre-integrated', s.preintegrated, (v) => sendSettings({ preintegrated: v })));
       for (let a = 0; a < 3; ++a) {
         const ax = 'xyz'[a];
         box.append(
