@@ -370,10 +370,15 @@ struct VolumeIntegrator {
             // steps long (grad: the gradient at p, for shading).
             auto compositeSegment = [&](const Mask<W>& m, const I& j, const I& jp, const P& len, auto&& grad)
                 __attribute__((always_inline)) {
+                // entries lo .. hi - 1; none of them in [tfVisibleLo, tfVisibleHi): no opacity,
+                // and no fetch when that holds for every lane (most segments, for narrow TFs)
+                const I lo = min(j, jp), hi = max(j, jp) + I(1);
+                const Mask<W> seen = m & (hi > I(int32_t(s.tfVisibleLo))) & (lo < I(int32_t(s.tfVisibleHi)));
+                if (!any(seen)) return;
                 Vec3<W> rgb;
                 P a;
-                segment<W>(s, min(j, jp), max(j, jp) + I(1), len, rgb, a);
-                a = select(m, a, P(0.0f));
+                segment<W>(s, lo, hi, len, rgb, a);
+                a = select(seen, a, P(0.0f));
                 const Mask<W> contrib = a > P(0.0f);
                 if (any(contrib)) {
                     if constexpr (mode == VolumeMode::Shaded) rgb = rgb * shadeFactor<W>(grad(), d);
