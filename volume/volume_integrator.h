@@ -366,29 +366,11 @@ struct VolumeIntegrator {
             const I cell[3] = {toInt(p.x), toInt(p.y), toInt(p.z)};
             const I c[3] = {cell[0] >> 3, cell[1] >> 3, cell[2] >> 3};
             const I sc[3] = {cell[0] >> 2, cell[1] >> 2, cell[2] >> 2};
-            // Pre-integration: composites lanes m's segments between TF entries j and jp, len
-            // steps long (grad: the gradient at p, for shading).
-            auto compositeSegment = [&](const Mask<W>& m, const I& j, const I& jp, const P& len, auto&& grad)
-                __attribute__((always_inline)) {
-                // entries lo .. hi - 1; none of them in [tfVisibleLo, tfVisibleHi): no opacity,
-                // and no fetch when that holds for every lane (most segments, for narrow TFs)
-                const I lo = min(j, jp), hi = max(j, jp) + I(1);
-                const Mask<W> seen = m & (hi > I(int32_t(s.tfVisibleLo))) & (lo < I(int32_t(s.tfVisibleHi)));
-                if (!any(seen)) return;
-                Vec3<W> rgb;
-                P a;
-                segment<W>(s, lo, hi, len, rgb, a);
-                a = select(seen, a, P(0.0f));
-                const Mask<W> contrib = a > P(0.0f);
-                if (any(contrib)) {
-                    if constexpr (mode == VolumeMode::Shaded) rgb = rgb * shadeFactor<W>(grad(), d);
-                    const P w = (P(1.0f) - alpha) * a;
-                    col += rgb * w;
-                    alpha += w;
-                    depth = min(depth, select(contrib, t, P(kInfinity)));
-                }
-                alive = alive & (alpha < term);
-            };
+            // Pre-integration: this step's segments (lanes that sample, and lanes that close theirs
+            // at the edge of an empty cube), composited once below
+            Mask<W> segM(false), closing(false);
+            I segJ(0), segJp(0);
+            P segLen(0.0f), segT(0.0f);
             Mask<W> samp = alive;
             I start(0);
             bool haveStart = false;
@@ -448,15 +430,10 @@ struct VolumeIntegrator {
                     if constexpr (kPre) {
                         // Lanes entering the empty cube from a sample: the segment up to here,
                         // whose values may pass visible ones on the way (the cube's own segments
-                        // add nothing: its values stay invisible).
-                        const Mask<W> closing = empty & prevOk;
-                        if (any(closing)) {
-                            sampleCount = sampleCount + select(closing, I(1), I(0));
-                            const I j = toInt(tfEntry<W>(s, sample<W, L>(s, p)));
-                            compositeSegment(closing, j, jPrev, kf - kfPrev, [&] {
-                                return s.gradients ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
-                            });
-                        }
+                        // add nothing: its values stay invisible). Its end is sampled below.
+                        closing = empty & prevOk;
+                        segLen = kf - kfPrev;
+                        segT = t;
                         prevOk = andNot(prevOk, empty);
                     }
                     const P kk = max(sampleIndexAt(tExit), kf + P(1.0f));
@@ -467,28 +444,36 @@ struct VolumeIntegrator {
                     samp = andNot(alive, empty);
                 }
             }
+            // Pre-integration's extra samples, one trilinear fetch for both kinds: the closing
+            // lanes' end here, and for a lane's first sample (entering the box or after a jump)
+            // the lattice point one step before, where its segment opens (after a jump: in the
+            // empty cube, an invisible value).
+            P kp = kfPrev;
+            if constexpr (kPre) {
+                const Mask<W> fresh = andNot(samp, prevOk), extra = closing | fresh;
+                segJp = jPrev;
+                if (any(extra)) {
+                    sampleCount = sampleCount + select(extra, I(1), I(0));
+                    const Vec3<W> back = clampToGrid<W>(s, oi + di * (tNear + (kf - P(0.5f)) * dt));
+                    const Vec3<W> q(select(closing, p.x, back.x), select(closing, p.y, back.y),
+                                    select(closing, p.z, back.z));
+                    const I je = toInt(tfEntry<W>(s, sample<W, L>(s, q)));
+                    segJ = je;
+                    segJp = select(fresh, je, segJp);
+                    kp = select(fresh, kf - P(1.0f), kp);
+                }
+                segM = closing;
+            }
             if (any(samp)) {
                 sampleCount = sampleCount + select(samp, I(1), I(0));
                 // sampling lanes have not moved since the brick lookup; the others are masked
                 const P v = haveStart ? sampleCell<W, L>(s, p, cell, start) : sample<W, L>(s, p);
                 if constexpr (kPre) {
-                    // The segment from the previous sample; a lane's first sample, on entering
-                    // the box or after a jump, takes the lattice point one step before (after a
-                    // jump: in the empty cube, an invisible value).
                     const I j = toInt(tfEntry<W>(s, v));
-                    I jp = jPrev;
-                    P kp = kfPrev;
-                    const Mask<W> fresh = andNot(samp, prevOk);
-                    if (any(fresh)) {
-                        const P tb = tNear + (kf - P(0.5f)) * dt;
-                        const P vb = sample<W, L>(s, clampToGrid<W>(s, oi + di * tb));
-                        sampleCount = sampleCount + select(fresh, I(1), I(0));
-                        jp = select(fresh, toInt(tfEntry<W>(s, vb)), jp);
-                        kp = select(fresh, kf - P(1.0f), kp);
-                    }
-                    compositeSegment(samp, j, jp, kf - kp, [&] {
-                        return s.gradients ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p);
-                    });
+                    segM = segM | samp;
+                    segJ = select(samp, j, segJ);
+                    segLen = select(samp, kf - kp, segLen);
+                    segT = select(samp, t, segT);
                     jPrev = select(samp, j, jPrev);
                     kfPrev = select(samp, kf, kfPrev);
                     prevOk = prevOk | samp;
@@ -552,6 +537,32 @@ struct VolumeIntegrator {
                 }
                 kf = select(samp, kf + mStep, kf);
                 t = select(samp, tNear + (kf + P(0.5f)) * dt, t);
+            }
+            if constexpr (kPre) {
+                // The segments over entries lo .. hi - 1; those with none in [tfVisibleLo,
+                // tfVisibleHi) have no opacity, and no fetch when that holds for every lane (most
+                // of them, for narrow TFs).
+                const I lo = min(segJ, segJp), hi = max(segJ, segJp) + I(1);
+                const Mask<W> seen = segM & (hi > I(int32_t(s.tfVisibleLo))) & (lo < I(int32_t(s.tfVisibleHi)));
+                if (any(seen)) {
+                    Vec3<W> rgb;
+                    P a;
+                    segment<W>(s, lo, hi, segLen, rgb, a);
+                    a = select(seen, a, P(0.0f));
+                    const Mask<W> contrib = a > P(0.0f);
+                    if (any(contrib)) {
+                        // shaded with the gradient where the segment ends (p, for both kinds)
+                        if constexpr (mode == VolumeMode::Shaded)
+                            rgb =
+                                rgb * shadeFactor<W>(
+                                          s.gradients ? gradientFromBricks<W>(s, p, cell, c) : gradient<W, L>(s, p), d);
+                        const P w = (P(1.0f) - alpha) * a;
+                        col += rgb * w;
+                        alpha += w;
+                        depth = min(depth, select(contrib, segT, P(kInfinity)));
+                    }
+                    alive = alive & (alpha < term);
+                }
             }
             alive = alive & (t < tFar);
             if (s.prefetchBricks) {
