@@ -45,16 +45,23 @@ std::pair<int, int> slabPlanes(int slices, int part, int parts) {
     return {int(cells * part / parts), int(cells * (part + 1) / parts)};
 }
 
-VolumePart loadVolumePart(const std::string& file, const OpenOptions& opt, int part, int parts) {
+int ghostSlices(const VolumeSettings& s) {
+    if (!s.preintegrated || !(s.step > 0) || !std::isfinite(s.step)) return kGhostSlices;
+    // a step is at most s.step slices along z (its length is s.step times the least spacing)
+    return std::max(kGhostSlices, int(std::min(std::ceil(s.step), 1e6f)) + 1);
+}
+
+VolumePart loadVolumePart(const std::string& file, const OpenOptions& opt, int part, int parts, int ghosts) {
     VolumePart p;
     p.part = part;
     p.parts = parts;
+    p.ghosts = ghosts;
     auto pick = [&](const std::array<int, 3>& dims) -> std::array<int, 2> {
         if (dims[2] - 1 < parts)
             throw UsageError("--distribute", "data: " + std::to_string(dims[2]) + " slices cannot be split into " +
                                                  std::to_string(parts) + " slabs (one cell each at least)");
         const auto [a, b] = slabPlanes(dims[2], part, parts);
-        return {std::max(0, a - kGhostSlices), std::min(dims[2], b + 1 + kGhostSlices)};
+        return {std::max(0, a - ghosts), std::min(dims[2], b + 1 + ghosts)};
     };
     volume::VolumeLoadOptions vo = opt.volume;
     vo.progress = opt.progress;
@@ -130,7 +137,7 @@ std::optional<Settings> partSettings(const VolumePart& p, const Settings& s) {
     const float lo = std::max(std::clamp(s.volume.clipLo.z, 0.0f, 1.0f) * n1, float(p.own0));
     const float hi = std::min(std::clamp(s.volume.clipHi.z, 0.0f, 1.0f) * n1, float(p.own1));
     if (!(lo < hi)) return std::nullopt;
-    const int loaded = std::min(p.dims[2], p.own1 + 1 + kGhostSlices) - p.z0;
+    const int loaded = std::min(p.dims[2], p.own1 + 1 + p.ghosts) - p.z0;
     v.clipLo.z = (lo - float(p.z0)) / float(loaded - 1);
     v.clipHi.z = (hi - float(p.z0)) / float(loaded - 1);
     return r;

@@ -289,6 +289,9 @@ struct VolumeIntegrator {
         I jPrev(0);
         P kfPrev(0.0f);
         Mask<W> prevOk(false);
+        // a data-parallel rank's lanes with a lattice point before their first (in a neighbour)
+        Mask<W> rankEntry(false);
+        if (kPre && s.settings.lattice) rankEntry = alive & (kf > P(0.5f));
 
         // Per axis, once a ray: the side of a brick the ray leaves by follows inv's sign (an
         // axis the ray runs along, inv +-1e20, gives a far exit, not a near one), and the
@@ -407,6 +410,17 @@ struct VolumeIntegrator {
                     // which lies past the pool of a sparse volume.
                     start = select(skipped, I(0), (info & I(Scene::kPoolMask)) * I(Scene::template kBrickStride<L>));
                     haveStart = true;
+                    if constexpr (kPre) {
+                        // A rank's first samples are taken even in an empty cube: the segment
+                        // into them starts on the neighbour's side, which does not composite it
+                        // (a segment the whole volume's march drops lies in one empty cube and
+                        // adds nothing). Their bricks then by the full lookup (sample()).
+                        if (any(rankEntry)) {
+                            haveStart = none(rankEntry & empty);
+                            empty = andNot(empty, rankEntry);
+                            rankEntry = Mask<W>(false);
+                        }
+                    }
                     if (adaptive) {
                         I l = (info >> 28) & I(3);
                         if (any(l > I(0))) {
@@ -420,7 +434,9 @@ struct VolumeIntegrator {
                             const Mask<W> subScope = (info & I(Scene::kSubScopeBit)) != I(0);
                             P exitT = cubeExit(c, I(1), invBrick);
                             if (any(subScope)) exitT = select(subScope, cubeExit(sc, I(1), invSub), exitT);
-                            const P room = min(exitT, tFar) - t;
+                            // Pre-integration: the next sample too, where the long step's
+                            // segment ends (past tFar none would composite it: a rank's seam).
+                            const P room = min(exitT, tFar) - t - (kPre ? dt : P(0.0f));
                             l = select(room > dt3, l, select(room > dt, min(l, I(1)), I(0)));
                         }
                         mStep = select(l == I(2), P(4.0f), select(l == I(1), P(2.0f), P(1.0f)));

@@ -112,7 +112,7 @@ int runMpiData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine
     if (int st = mpi.agree(attempt([&] {
             engine::OpenOptions o = data.options();
             o.progress = !c.quiet;
-            part = engine::loadVolumePart(data.file, o, mpi.rank, mpi.size);
+            part = engine::loadVolumePart(data.file, o, mpi.rank, mpi.size, engine::ghostSlices(s.volume));
         })))
         return st;
     fig[kLoadMs] = engine::msSince(t0);
@@ -180,7 +180,7 @@ int runMpiData(const mpi::Mpi& mpi, CommonOptions& c, const std::function<engine
         st.add("mpi_distribute", "data");
         st.add("volume_dims",
                std::to_string(part.dims[0]) + "x" + std::to_string(part.dims[1]) + "x" + std::to_string(part.dims[2]));
-        st.add("mpi_ghost_slices", engine::kGhostSlices);
+        st.add("mpi_ghost_slices", part.ghosts);
         for (int r = 0; r < mpi.size; ++r) {
             const double* f = &all[size_t(r) * kFigures];
             const std::string k = "rank" + std::to_string(r) + "_";

@@ -219,6 +219,29 @@ elif [ "$what" = data ]; then
       [ "$total" -le $(((64 + np * 6) * 8192)) ] || fail "$name -np $np: ranks loaded $total bytes together"
     done
   done
+  # Pre-integration: each segment composited by one rank (a rank's first sample taken even
+  # in an empty cube, long steps ending before the slab's end) and a rank's look-back a step
+  # into its neighbour's ghosts (step 4: 5 ghost slices), under a view along z: no seam.
+  steep=(--eye 38,36,140 --at 31.5,31.5,31.5 --up 0,1,0)
+  for vol in slab:1 slab:4 phantom:1 phantom:4; do
+    name=${vol%%:*} step=${vol##*:}
+    pre=(--tf seam.json --preintegrated --step "$step" "${steep[@]}")
+    timeout 300 "$rtfact" volume "$name.mhd" "${pre[@]}" "${vcommon[@]}" -o "pre-$name-$step.exr" ||
+      fail "pre-integrated $name step $step: single-process render"
+    for np in 2 3; do
+      out="pre-$name-$step-np$np.exr"
+      timeout 300 "${launch[@]}" -np "$np" "$rtfact" volume "$name.mhd" "${pre[@]}" "${vcommon[@]}" --distribute data \
+        --stats -o "$out" >"$out.stats" 2>"$out.err" || {
+        fail "pre-integrated $name step $step -np $np exited $?: $(cat "$out.err")"
+        continue
+      }
+      idiff -fail 1e-4 -failpercent 0 "pre-$name-$step.exr" "$out" >/dev/null ||
+        fail "pre-integrated $name step $step -np $np: differs by more than 1e-4 (a seam?): $(idiff "pre-$name-$step.exr" "$out" | grep Max)"
+      ghosts=$((step > 1 ? step + 1 : 2))
+      [ "$(stat_of "$out.stats" mpi_ghost_slices)" = "$ghosts" ] ||
+        fail "pre-integrated step $step: $(stat_of "$out.stats" mpi_ghost_slices) ghost slices, want $ghosts"
+    done
+  done
   # NRRD over the same voxels, raw (one seek per slab) and gzip (decompressed up to the
   # slab): the same image as the MetaImage on one process.
   gzip -kf phantom.raw
