@@ -632,3 +632,35 @@ TEST(VolumePreintegration, ThinShellMatchesClosedFormAtLongSteps) {
         }
     }
 }
+
+// A clip plane at a step in the values: 255 (in the TF's band) up to z = 19, 100 (below the
+// band) from z = 20, clipped at z = 20 and marched without skipping: inside the box every
+// value is 100, so nothing may show (the plain march: alpha 0). A ray's first segment opens a
+// step before its first sample, outside the box: its look-back sample is taken at the clip
+// face (100), not beyond it, where the hidden side's values (177 at z = 19.5) would add a film
+// of the band.
+TEST(VolumePreintegration, ClipPlaneHidesWhatLiesBeyond) {
+    const BrickedVolume g = brickVolume(
+        linearGrid<uint8_t>(9, 9, 64, Storage::U8, [](float, float, float z) { return z < 19.5f ? 255.0f : 100.0f; }));
+    TransferFunction tf;
+    tf.colors = {{0.0f, {1, 1, 1}}, {1.0f, {1, 1, 1}}};
+    tf.opacity = {{0.0f, 0.0f}, {0.5f, 0.0f}, {0.51f, 0.5f}, {1.0f, 0.5f}};
+    for (float step : {0.5f, 1.0f, 2.0f, 4.0f}) {
+        for (bool pre : {false, true}) {
+            VolumeRenderSettings rs;
+            rs.stepVoxels = step;
+            rs.maxStepMultiple = 1;
+            rs.skipping = false;
+            rs.preintegrated = pre;
+            rs.clipLo.z = 20.0f / 63.0f;
+            const VolumeScene<uint8_t> s(g, buildTable(tf, {0.0f, 255.0f}, step), rs);
+            RayPacket<kW> rays;
+            for (int i = 0; i < kW; ++i) rays.setLane(i, {1.0f + 6.0f * float(i) / kW, 4.0f, -5.0f}, {0, 0, 1});
+            rays.finalize();
+            const Radiance<kW> r = VolumeIntegrator{}.eval<kW>(s, rays, Mask<kW>(true), PixelSample<kW>{});
+            for (int i = 0; i < kW; ++i)
+                EXPECT_EQ(r.alpha[i], 0.0f)
+                    << "step " << step << (pre ? ", pre-integrated" : ", plain") << ", lane " << i;
+        }
+    }
+}
