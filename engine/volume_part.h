@@ -16,13 +16,17 @@
 
 namespace rtfact::engine {
 
+// Ghost slices on each side of a slab: trilinear sampling needs 1, the central
+// differences of shaded DVR 1 more.
+inline constexpr int kGhostSlices = 2;
+
 struct VolumePart {
     int part = 0, parts = 1;
     std::array<int, 3> dims{};  // the whole volume's
     Vec3f origin, spacing;      // the whole volume's
     int own0 = 0, own1 = 0;     // the slab: planes [own0, own1] of the whole volume (cells between)
     int z0 = 0;                 // first slice loaded (own0 minus the ghosts)
-    int ghosts = 0;             // ghost slices read on each side (ghostSlices)
+    int ghosts = kGhostSlices;  // ghost slices read on each side (ghostSlices)
     bool readWhole = false;     // the format has no slab access (read whole, cropped)
     uint64_t loadedBytes = 0;   // voxel bytes held after loading
     volume::VolumeGrid grid;    // the loaded slices, until partScene() bricks them
@@ -39,9 +43,6 @@ struct VolumePart {
     volume::ValueHistogram ownedHistogram(float lo, float hi) const;
 };
 
-// Ghost slices on each side of a slab: trilinear sampling needs 1, the central
-// differences of shaded DVR 1 more.
-inline constexpr int kGhostSlices = 2;
 // The ghost slices for settings s: kGhostSlices, and for a pre-integrated march one more
 // than a step's voxels (a rank's first sample looks back a step into its neighbour).
 int ghostSlices(const VolumeSettings& s);
@@ -49,8 +50,9 @@ int ghostSlices(const VolumeSettings& s);
 // Slab planes [own0, own1] of part `part` of `parts` for `slices` slices (balanced cells).
 std::pair<int, int> slabPlanes(int slices, int part, int parts);
 
-// Reads part `part` of `parts` of a volume file with `ghosts` ghost slices; throws Error (file unreadable, or cut
-// short before the end of this part's slices) or UsageError (fewer cells than parts).
+// Reads part `part` of `parts` of a volume file with `ghosts` ghost slices; throws Error
+// (file unreadable, or cut short before the end of this part's slices) or UsageError (fewer
+// cells than parts).
 VolumePart loadVolumePart(const std::string& file, const OpenOptions& opt, int part, int parts,
                           int ghosts = kGhostSlices);
 

@@ -567,25 +567,32 @@ TEST(VolumeSkipping, DistanceMapIsChebyshevAndJumpsChangeNoPixel) {
 
 namespace {
 
-// Transmittance of kW parallel rays down z (plain march or pre-integrated, no long steps).
-std::vector<float> zTransmittance(const BrickedVolume& g, const TFTable& table, float step, bool pre) {
-    VolumeRenderSettings rs;
-    rs.stepVoxels = step;
-    rs.maxStepMultiple = 1;
-    rs.preintegrated = pre;
+// Opacity of kW parallel rays down z (x from 1 to 7, y = 4) under settings rs.
+std::vector<float> zAlpha(const BrickedVolume& g, const TFTable& table, const VolumeRenderSettings& rs) {
     const VolumeScene<uint8_t> s(g, table, rs);
-    EXPECT_EQ(s.tfIntegral.empty(), !pre);
+    EXPECT_EQ(s.tfIntegral.empty(), !rs.preintegrated);
     RayPacket<kW> rays;
     for (int i = 0; i < kW; ++i) rays.setLane(i, {1.0f + 6.0f * float(i) / kW, 4.0f, -5.0f}, {0, 0, 1});
     rays.finalize();
     PixelSample<kW> ps;
     const Radiance<kW> r = VolumeIntegrator{}.eval<kW>(s, rays, Mask<kW>(true), ps);
-    std::vector<float> T(kW);
-    for (int i = 0; i < kW; ++i) T[size_t(i)] = 1.0f - r.alpha[i];
+    std::vector<float> A(kW);
+    for (int i = 0; i < kW; ++i) A[size_t(i)] = r.alpha[i];
     // the single-ray march gives the same
     RayPacket<1> one = rays.lane(kW / 2);
     const Radiance<1> r1 = VolumeIntegrator{}.eval<1>(s, one, Mask<1>(true), PixelSample<1>{});
-    EXPECT_NEAR(1.0f - float(r1.alpha), T[kW / 2], 1e-6f);
+    EXPECT_NEAR(1.0f - float(r1.alpha), 1.0f - A[kW / 2], 1e-6f);
+    return A;
+}
+
+// Transmittance of those rays (plain march or pre-integrated, no long steps).
+std::vector<float> zTransmittance(const BrickedVolume& g, const TFTable& table, float step, bool pre) {
+    VolumeRenderSettings rs;
+    rs.stepVoxels = step;
+    rs.maxStepMultiple = 1;
+    rs.preintegrated = pre;
+    std::vector<float> T = zAlpha(g, table, rs);
+    for (float& t : T) t = 1.0f - t;
     return T;
 }
 
@@ -653,13 +660,9 @@ TEST(VolumePreintegration, ClipPlaneHidesWhatLiesBeyond) {
             rs.skipping = false;
             rs.preintegrated = pre;
             rs.clipLo.z = 20.0f / 63.0f;
-            const VolumeScene<uint8_t> s(g, buildTable(tf, {0.0f, 255.0f}, step), rs);
-            RayPacket<kW> rays;
-            for (int i = 0; i < kW; ++i) rays.setLane(i, {1.0f + 6.0f * float(i) / kW, 4.0f, -5.0f}, {0, 0, 1});
-            rays.finalize();
-            const Radiance<kW> r = VolumeIntegrator{}.eval<kW>(s, rays, Mask<kW>(true), PixelSample<kW>{});
+            const std::vector<float> A = zAlpha(g, buildTable(tf, {0.0f, 255.0f}, step), rs);
             for (int i = 0; i < kW; ++i)
-                EXPECT_EQ(r.alpha[i], 0.0f)
+                EXPECT_EQ(A[size_t(i)], 0.0f)
                     << "step " << step << (pre ? ", pre-integrated" : ", plain") << ", lane " << i;
         }
     }
