@@ -224,22 +224,28 @@ TEST(VolumeDVR, EmptySpaceSkippingChangesNoPixel) {
 // bit-identical rays (core test Render.CameraRaysBitIdenticalAtEveryPacketSize): on AVX2
 // the 256-ray packets once got rays one ulp off, and a MIP pixel whose maximum sat on a
 // transfer-function entry boundary jumped one entry (0.001). The 1e-4 left is for the
-// scalar (W = 1) and vector marches contracting their arithmetic differently.
+// scalar (W = 1) and vector marches contracting their arithmetic differently. Every voxel
+// layout the march reads: u8 from its y-z quads, u16 from its y-pairs (the benchmarks' CT
+// and phantom path), f32 from the brick pool.
 TEST(VolumeDVR, PacketAndSingleRayGiveTheSameImage) {
-    const VolumeGrid ph = makeSheppLogan(48, Storage::U8);
     const TransferFunction tf = transferFunctionPreset("viridis");
-    for (VolumeMode m : {VolumeMode::DVR, VolumeMode::Shaded, VolumeMode::MIP, VolumeMode::Iso, VolumeMode(-1)}) {
-        VolumeRenderSettings rs;
-        rs.mode = m;
-        if (int(m) < 0) rs.mode = VolumeMode::DVR, rs.preintegrated = true;  // pre-integrated DVR
-        const Rendered one = render<1>(ph, tf, rs, 64, 64);
-        const Rendered p16 = render<16>(ph, tf, rs, 64, 64);
-        const Rendered p64 = render<64>(ph, tf, rs, 64, 64);
-        const Rendered p256 = render<256>(ph, tf, rs, 64, 64);
-        EXPECT_LE(maxAbsDiff(one.rgba, p16.rgba), 1e-4f) << int(m);
-        EXPECT_LE(maxAbsDiff(one.rgba, p64.rgba), 1e-4f) << int(m);
-        EXPECT_LE(maxAbsDiff(one.rgba, p256.rgba), 1e-4f) << int(m);
-        EXPECT_EQ(one.samples, p64.samples) << int(m);
+    for (Storage st : {Storage::U8, Storage::U16, Storage::F32}) {
+        const VolumeGrid ph = makeSheppLogan(48, st);
+        for (VolumeMode m : {VolumeMode::DVR, VolumeMode::Shaded, VolumeMode::MIP, VolumeMode::Iso, VolumeMode(-1)}) {
+            VolumeRenderSettings rs;
+            rs.mode = m;
+            if (int(m) < 0) rs.mode = VolumeMode::DVR, rs.preintegrated = true;  // pre-integrated DVR
+            const std::string what = std::string(storageName(st)) + " mode " + std::to_string(int(m));
+            const Rendered one = render<1>(ph, tf, rs, 64, 64);
+            const Rendered p16 = render<16>(ph, tf, rs, 64, 64);
+            const Rendered p64 = render<64>(ph, tf, rs, 64, 64);
+            const Rendered p256 = render<256>(ph, tf, rs, 64, 64);
+            EXPECT_GT(one.samples, 0u) << what;
+            EXPECT_LE(maxAbsDiff(one.rgba, p16.rgba), 1e-4f) << what;
+            EXPECT_LE(maxAbsDiff(one.rgba, p64.rgba), 1e-4f) << what;
+            EXPECT_LE(maxAbsDiff(one.rgba, p256.rgba), 1e-4f) << what;
+            EXPECT_EQ(one.samples, p64.samples) << what;
+        }
     }
 }
 
