@@ -263,8 +263,7 @@ struct VolumeIntegrator {
             // inside this rank's box; tNear then stands for the lattice's start.
             P tL = tMin;
             for (int a = 0; a < 3; ++a) {
-                const P lo((s.settings.latticeLo[a] - s.origin[a]) * s.invSpacing[a]);
-                const P hi((s.settings.latticeHi[a] - s.origin[a]) * s.invSpacing[a]);
+                const P lo(s.latticeBoxLo[a]), hi(s.latticeBoxHi[a]);
                 tL = max(tL, min((lo - oi[a]) * inv[a], (hi - oi[a]) * inv[a]));
             }
             kf = max(P(0.0f), -floor(-((tNear - tL) * invDt - P(0.5f))));
@@ -292,15 +291,6 @@ struct VolumeIntegrator {
         // a data-parallel rank's lanes with a lattice point before their first (in a neighbour)
         Mask<W> rankEntry(false);
         if (kPre && s.settings.lattice) rankEntry = alive & (kf > P(0.5f));
-        // A ray's first segment opens a step before its first sample, outside the box: its
-        // look-back sample is taken at the box's face (the whole volume's on a data-parallel
-        // rank), so that a clip plane hides what lies beyond it.
-        Vec3f backLo = s.boxLo, backHi = s.boxHi;
-        if (kPre && s.settings.lattice)
-            for (int a = 0; a < 3; ++a) {
-                backLo[a] = (s.settings.latticeLo[a] - s.origin[a]) * s.invSpacing[a];
-                backHi[a] = (s.settings.latticeHi[a] - s.origin[a]) * s.invSpacing[a];
-            }
 
         // Per axis, once a ray: the side of a brick the ray leaves by follows inv's sign (an
         // axis the ray runs along, inv +-1e20, gives a far exit, not a near one), and the
@@ -482,10 +472,14 @@ struct VolumeIntegrator {
                 segJp = jPrev;
                 if (any(extra)) {
                     sampleCount = sampleCount + select(extra, I(1), I(0));
+                    // A ray's first segment opens a step before its first sample, outside the
+                    // box: its look-back sample is taken at the lattice box's face, so that a
+                    // clip plane hides what lies beyond it.
                     const Vec3<W> q0 = oi + di * (tNear + (kf - P(0.5f)) * dt);
-                    const Vec3<W> back = clampToGrid<W>(
-                        s, Vec3<W>(clamp(q0.x, P(backLo.x), P(backHi.x)), clamp(q0.y, P(backLo.y), P(backHi.y)),
-                                   clamp(q0.z, P(backLo.z), P(backHi.z))));
+                    const Vec3f &lo = s.latticeBoxLo, &hi = s.latticeBoxHi;
+                    const Vec3<W> back =
+                        clampToGrid<W>(s, Vec3<W>(clamp(q0.x, P(lo.x), P(hi.x)), clamp(q0.y, P(lo.y), P(hi.y)),
+                                                  clamp(q0.z, P(lo.z), P(hi.z))));
                     const Vec3<W> q(select(closing, p.x, back.x), select(closing, p.y, back.y),
                                     select(closing, p.z, back.z));
                     const I je = toInt(tfEntry<W>(s, sample<W, L>(s, q)));

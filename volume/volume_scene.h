@@ -96,8 +96,12 @@ struct VolumeScene {
     int32_t nbx = 0, nbxy = 0;  // brick grid strides
     Vec3f origin, invSpacing, spacing;
     Vec3f boxLo, boxHi;  // index space, after clipping
-    Vec3f clampHi;       // largest coordinate trilinear sampling may use per axis
-    float dt = 0.5f;     // world-space step
+    // The box whose lattice the samples lie on (index space): boxLo/boxHi, on a data-parallel
+    // rank (settings.lattice) the whole volume's. A pre-integrated ray's first look-back sample,
+    // a step before the box, is taken at its face.
+    Vec3f latticeBoxLo, latticeBoxHi;
+    Vec3f clampHi;    // largest coordinate trilinear sampling may use per axis
+    float dt = 0.5f;  // world-space step
     VolumeRenderSettings settings;
     // Transfer function: entry = stored * tfMul + tfAdd.
     TFTable tf;
@@ -196,6 +200,8 @@ struct VolumeScene {
             const float n1 = float(dims[a] - 1);
             boxLo[a] = std::clamp(s.clipLo[a], 0.0f, 1.0f) * n1;
             boxHi[a] = std::clamp(s.clipHi[a], 0.0f, 1.0f) * n1;
+            latticeBoxLo[a] = s.lattice ? (s.latticeLo[a] - origin[a]) * invSpacing[a] : boxLo[a];
+            latticeBoxHi[a] = s.lattice ? (s.latticeHi[a] - origin[a]) * invSpacing[a] : boxHi[a];
             clampHi[a] = std::nextafter(n1, 0.0f);
         }
         if (!(s.stepVoxels > 0) || !std::isfinite(s.stepVoxels)) throw Error("--step", "step must be positive");
