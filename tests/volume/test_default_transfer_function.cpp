@@ -12,9 +12,7 @@
 
 #include "core/render/framebuffer.h"
 #include "core/render/pinhole_camera.h"
-#include "core/render/pixel_center_sampler.h"
-#include "core/render/ray_tracing_renderer.h"
-#include "core/render/tile_scheduler.h"
+#include "render_volume_image.h"
 #include "volume/default_transfer_function.h"
 #include "volume/dicom_modality.h"
 #include "volume/value_histogram.h"
@@ -343,7 +341,7 @@ Image renderWith(const BrickedVolume& v, const TransferFunction& tf, std::pair<f
         RGBAFramebuffer fb(size, size);
         RenderOptions ro;
         ro.progress = false;
-        renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+        test::renderVolumeImage(64, scene, cam, fb, ro);
         img.rgba = fb.resolved(1);
     });
     return img;

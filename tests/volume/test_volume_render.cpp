@@ -11,9 +11,7 @@
 #include "common/image_compare.h"
 #include "core/render/framebuffer.h"
 #include "core/render/pinhole_camera.h"
-#include "core/render/pixel_center_sampler.h"
-#include "core/render/ray_tracing_renderer.h"
-#include "core/render/tile_scheduler.h"
+#include "render_volume_image.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
@@ -89,11 +87,10 @@ Rendered render(const VolumeGrid& g, const TransferFunction& tf, VolumeRenderSet
         const PinholeCamera cam(fitCamera(scene.bounds(), 40.0f, float(w) / float(h), {0.45f, -1.0f, 0.35f}, {0, 0, 1}),
                                 w, h);
         RGBAFramebuffer fb(w, h);
-        const RayTracingRenderer<PixelCenterSampler, VolumeIntegrator> r{};
         RenderOptions ro;
         ro.threads = 2;
         ro.progress = false;
-        const RenderStats st = renderImage<N>(r, scene, cam, fb, ro);
+        const RenderStats st = test::renderVolumeImage(N, scene, cam, fb, ro);
         out.rgba = fb.resolved(1);
         out.samples = st.counters.volumeSamples;
         out.skipped = st.counters.volumeSkipped;
@@ -315,7 +312,7 @@ TEST(VolumeBricks, SparseVdbRendersLikeDense) {
             RGBAFramebuffer fb(64, 64);
             RenderOptions ro;
             ro.progress = false;
-            renderImage<16>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+            test::renderVolumeImage(16, scene, cam, fb, ro);
             img[idx++] = fb.resolved(1);
         });
     }

@@ -9,9 +9,7 @@
 
 #include "core/render/framebuffer.h"
 #include "core/render/pinhole_camera.h"
-#include "core/render/pixel_center_sampler.h"
-#include "core/render/ray_tracing_renderer.h"
-#include "core/render/tile_scheduler.h"
+#include "render_volume_image.h"
 #include "volume/volume_generators.h"
 #include "volume/volume_integrator.h"
 #include "volume/volume_scene.h"
@@ -103,7 +101,7 @@ std::vector<float> renderView(const Scene& scene, const PinholeCamera& cam, int 
     RGBAFramebuffer fb(w, h);
     RenderOptions ro;
     ro.progress = false;
-    renderImage<64>(RayTracingRenderer<PixelCenterSampler, VolumeIntegrator>{}, scene, cam, fb, ro);
+    test::renderVolumeImage(64, scene, cam, fb, ro);
     return fb.resolved(1);
 }
 
