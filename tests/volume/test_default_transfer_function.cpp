@@ -17,7 +17,6 @@
 #include "volume/dicom_modality.h"
 #include "volume/value_histogram.h"
 #include "volume/volume_generators.h"
-#include "volume/volume_integrator.h"
 #include "volume/volume_io.h"
 #include "volume/volume_scene.h"
 

@@ -76,8 +76,9 @@ struct Rendered {
     uint64_t samples, skipped;
 };
 
-template <int N>
-Rendered render(const VolumeGrid& g, const TransferFunction& tf, VolumeRenderSettings rs, int w = 128, int h = 128) {
+// packet: the rays a packet (renderVolumeImage's sizes)
+Rendered render(int packet, const VolumeGrid& g, const TransferFunction& tf, VolumeRenderSettings rs, int w = 128,
+                int h = 128) {
     const BrickedVolume bv = brickVolume(g);
     const auto [lo, hi] = bv.valueRange();
     const TFTable table = buildTable(tf, resolveWindow(tf, lo, hi, std::nullopt, std::nullopt), rs.stepVoxels);
@@ -90,7 +91,7 @@ Rendered render(const VolumeGrid& g, const TransferFunction& tf, VolumeRenderSet
         RenderOptions ro;
         ro.threads = 2;
         ro.progress = false;
-        const RenderStats st = test::renderVolumeImage(N, scene, cam, fb, ro);
+        const RenderStats st = test::renderVolumeImage(packet, scene, cam, fb, ro);
         out.rgba = fb.resolved(1);
         out.samples = st.counters.volumeSamples;
         out.skipped = st.counters.volumeSkipped;
@@ -202,7 +203,7 @@ TEST(VolumeDVR, EmptySpaceSkippingChangesNoPixel) {
             on.mode = off.mode = m;
             on.preintegrated = off.preintegrated = pre;
             off.skipping = false;
-            const Rendered a = render<16>(ph, tf, on), b = render<16>(ph, tf, off);
+            const Rendered a = render(16, ph, tf, on), b = render(16, ph, tf, off);
             // identical sample positions: tolerance only for float noise
             EXPECT_LE(maxAbsDiff(a.rgba, b.rgba), 1e-6f) << int(m) << " pre " << pre;
             EXPECT_GT(a.skipped, 0u) << int(m);
@@ -213,7 +214,7 @@ TEST(VolumeDVR, EmptySpaceSkippingChangesNoPixel) {
     VolumeRenderSettings on, off;
     on.mode = off.mode = VolumeMode::Iso;
     off.skipping = false;
-    const Rendered a = render<16>(ph, tf, on), b = render<16>(ph, tf, off);
+    const Rendered a = render(16, ph, tf, on), b = render(16, ph, tf, off);
     EXPECT_LE(maxAbsDiff(a.rgba, b.rgba), 0.02f);
 }
 
@@ -233,16 +234,16 @@ TEST(VolumeDVR, PacketAndSingleRayGiveTheSameImage) {
             rs.mode = m;
             if (int(m) < 0) rs.mode = VolumeMode::DVR, rs.preintegrated = true;  // pre-integrated DVR
             const std::string what = std::string(storageName(st)) + " mode " + std::to_string(int(m));
-            const Rendered one = render<1>(ph, tf, rs, 64, 64);
+            const Rendered one = render(1, ph, tf, rs, 64, 64);
             // one native chunk (the one-chunk march: on AVX2 16 rays are two chunks; a scalar
             // build's is the single ray), then groups
             if constexpr (kW != 1 && kW != 16) {
-                const Rendered pn = render<kW>(ph, tf, rs, 64, 64);
+                const Rendered pn = render(kW, ph, tf, rs, 64, 64);
                 EXPECT_LE(maxAbsDiff(one.rgba, pn.rgba), 1e-4f) << what;
             }
-            const Rendered p16 = render<16>(ph, tf, rs, 64, 64);
-            const Rendered p64 = render<64>(ph, tf, rs, 64, 64);
-            const Rendered p256 = render<256>(ph, tf, rs, 64, 64);
+            const Rendered p16 = render(16, ph, tf, rs, 64, 64);
+            const Rendered p64 = render(64, ph, tf, rs, 64, 64);
+            const Rendered p256 = render(256, ph, tf, rs, 64, 64);
             EXPECT_GT(one.samples, 0u) << what;
             EXPECT_LE(maxAbsDiff(one.rgba, p16.rgba), 1e-4f) << what;
             EXPECT_LE(maxAbsDiff(one.rgba, p64.rgba), 1e-4f) << what;
@@ -265,7 +266,7 @@ TEST_P(ToothRegression, MatchesReference) {
               : mode == "iso"  ? VolumeMode::Iso
                                : VolumeMode::DVR;
     const TransferFunction tf = transferFunctionPreset(mode == "mip" ? "grayscale" : "ct-bone");
-    const Rendered r = render<64>(tooth(), tf, rs, 160, 160);
+    const Rendered r = render(64, tooth(), tf, rs, 160, 160);
     test::expectMatchesReference(std::string(RTFACT_TEST_DATA) + "/tooth_" + mode + ".png", r.w, r.h, r.rgba);
 }
 INSTANTIATE_TEST_SUITE_P(Modes, ToothRegression, ::testing::Values("dvr", "shaded", "mip", "iso"));
@@ -504,7 +505,7 @@ TEST(VolumeAdaptiveSteps, CloseToPlainMarchWithFewerSamples) {
         adaptive.mode = plain.mode = m;
         adaptive.stepVoxels = plain.stepVoxels = 1.0f;
         plain.maxStepMultiple = 1;
-        const Rendered a = render<16>(ph, tf, adaptive), p = render<16>(ph, tf, plain);
+        const Rendered a = render(16, ph, tf, adaptive), p = render(16, ph, tf, plain);
         if (m == VolumeMode::DVR || m == VolumeMode::Shaded) {
             EXPECT_GE(psnrOf(a.rgba, p.rgba), 40.0) << int(m);
             double sa = 0, sp = 0;
@@ -568,7 +569,7 @@ TEST(VolumeSkipping, DistanceMapIsChebyshevAndJumpsChangeNoPixel) {
         VolumeRenderSettings on, off;
         on.mode = off.mode = m;
         off.skipping = false;
-        const Rendered a = render<16>(g, tf, on), b = render<16>(g, tf, off);
+        const Rendered a = render(16, g, tf, on), b = render(16, g, tf, off);
         EXPECT_LE(maxAbsDiff(a.rgba, b.rgba), 1e-6f) << int(m);
         EXPECT_GT(a.skipped, 10 * a.samples) << int(m);
     }
